@@ -1,0 +1,39 @@
+// What the CLI traces: a mesh file or a scene file, loaded once, with the structures built over it.
+#pragma once
+
+#include "accel/accelerator.h"
+#include "accel/mesh.h"
+#include "accel/params.h"
+#include "datasets/rays.h"
+
+#include <memory>
+#include <string>
+
+namespace ab {
+
+struct Scene;  // tracer/scene.h
+
+/// A loaded mesh (plain triangles, inst = 0xFFFFFFFF) or scene (instances).
+struct Target {
+  std::string path;
+  std::shared_ptr<const Mesh> mesh;    ///< set for a mesh
+  std::shared_ptr<const Scene> scene;  ///< set for a scene
+  uint64_t triangles = 0;              ///< triangles (for a scene: world-space triangles over all instances)
+  AABB bounds;
+};
+
+/// Loads --mesh F or --scene F (exactly one non-empty). Throws InputError naming the file.
+Target load_target(const std::string& mesh_path, const std::string& scene_path);
+/// Wraps an in-memory mesh (generated meshes in suites and tests).
+Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name);
+
+/// Creates (not builds) accelerator `name` over the target. For a scene, `name` serves at both levels
+/// unless `top` or `bottom` is given. Throws InputError / ParamError / UnknownAccelerator.
+std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name, Params params,
+                                                     const std::string& top = "", const std::string& bottom = "");
+
+/// What ray generation needs of the target (bounds, a closest-hit trace through a fast structure of the
+/// project, normals at hits).
+RayTarget ray_target(const Target& target);
+
+}  // namespace ab
