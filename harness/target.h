@@ -5,6 +5,7 @@
 #include "accel/mesh.h"
 #include "accel/params.h"
 #include "datasets/rays.h"
+#include "harness/compare.h"
 
 #include <memory>
 #include <string>
@@ -35,5 +36,8 @@ std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const
 /// What ray generation needs of the target (bounds, a closest-hit trace through a fast structure of the
 /// project, normals at hits).
 RayTarget ray_target(const Target& target);
+
+/// The world-space triangle of a hit on the target (used to explain disagreements with Embree).
+HitTriangleFn hit_triangles(const Target& target);
 
 }  // namespace ab

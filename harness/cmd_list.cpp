@@ -1,0 +1,58 @@
+// `accelbench list [--json]`: accelerators, mesh generators and ray kinds.
+#include "accel/registry.h"
+#include "datasets/generators.h"
+#include "datasets/rays.h"
+#include "harness/cli.h"
+
+#include <nlohmann/json.hpp>
+
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+namespace ab {
+namespace {
+
+nlohmann::json listing() {
+  nlohmann::json j;
+  j["accelerators"] = nlohmann::json::array();
+  for (const auto& a : accelerators()) {
+    if (a.name.rfind("test-", 0) == 0) continue;
+    j["accelerators"].push_back({{"name", a.name},
+                                 {"description", a.description},
+                                 {"reference", a.is_reference},
+                                 {"top_level", static_cast<bool>(a.make_for_instances)}});
+  }
+  j["generators"] = nlohmann::json::array();
+  for (const auto& g : generators()) j["generators"].push_back({{"name", g.name}, {"description", g.description}});
+  j["ray_kinds"] = nlohmann::json::array();
+  for (const auto& k : ray_kinds()) j["ray_kinds"].push_back({{"name", k.name}, {"description", k.description}});
+  return j;
+}
+
+void print_section(const std::string& title, const nlohmann::json& items) {
+  std::cout << title << ":\n";
+  for (const auto& item : items)
+    std::cout << "  " << std::left << std::setw(16) << item["name"].get<std::string>() << " "
+              << item["description"].get<std::string>() << "\n";
+}
+
+const CommandRegistrar kList{{"list", "names of accelerators, mesh generators and ray kinds", 10,
+                              [](CLI::App& app) -> std::function<int()> {
+                                auto json = std::make_shared<bool>(false);
+                                app.add_flag("--json", *json, "print as JSON");
+                                return [json] {
+                                  const nlohmann::json j = listing();
+                                  if (*json) {
+                                    std::cout << j.dump(2) << "\n";
+                                  } else {
+                                    print_section("accelerators", j["accelerators"]);
+                                    print_section("generators", j["generators"]);
+                                    print_section("ray kinds", j["ray_kinds"]);
+                                  }
+                                  return 0;
+                                };
+                              }}};
+
+}  // namespace
+}  // namespace ab

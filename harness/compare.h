@@ -1,0 +1,52 @@
+// Comparing hit arrays: byte-identical against brute, and the explained agreement with Embree.
+#pragma once
+
+#include "accel/geometry.h"
+#include "accel/triangle.h"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <span>
+#include <vector>
+
+namespace ab {
+
+/// Result of a byte-for-byte comparison.
+struct IdenticalResult {
+  uint64_t compared = 0;
+  uint64_t differing = 0;
+  std::vector<uint64_t> first_differences;  ///< up to 10 ray indices
+  /// True when every record matched.
+  bool identical() const { return differing == 0; }
+};
+
+/// Compares two hit arrays record by record, bit for bit (t, prim, inst, u, v).
+IdenticalResult compare_identical(std::span<const Hit> expected, std::span<const Hit> actual);
+
+/// How two independent implementations (ours and Embree's) relate on each ray.
+struct Agreement {
+  uint64_t agree = 0;        ///< same (inst, prim) and t within a relative 1e-4, or both miss
+  uint64_t tie = 0;          ///< different primitives hit at the same t (duplicates, shared edges, coplanar)
+  uint64_t edge = 0;         ///< a hit lies on or within 1e-4 (barycentric) of an edge or vertex of its triangle
+  uint64_t graze = 0;        ///< a hit triangle is nearly parallel to the ray (|cos| < 1e-3)
+  uint64_t limit = 0;        ///< a hit t is within rounding of tmin or tmax
+  uint64_t unexplained = 0;  ///< anything else: a real disagreement
+  std::vector<uint64_t> unexplained_rays;  ///< up to 10 ray indices
+
+  /// Disagreements that are explained by arithmetic (tie, edge, graze, limit).
+  uint64_t explained() const { return tie + edge + graze + limit; }
+};
+
+/// World-space triangle of a hit (mesh: triangle prim; scene: the instance's transformed triangle).
+using HitTriangleFn = std::function<Triangle(const Hit&)>;
+
+/// Classifies each ray's pair of hits (ours, embree's).
+Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours, std::span<const Hit> theirs,
+                             const HitTriangleFn& triangle_of);
+
+/// JSON forms for reports.
+nlohmann::json to_json(const IdenticalResult& r);
+nlohmann::json to_json(const Agreement& a);
+
+}  // namespace ab

@@ -1,0 +1,66 @@
+#include "harness/target.h"
+
+#include "accel/error.h"
+#include "accel/registry.h"
+#include "datasets/mesh_io.h"
+
+namespace ab {
+
+Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name) {
+  Target t;
+  t.path = std::move(name);
+  t.triangles = mesh->size();
+  t.bounds = mesh->bounds();
+  t.mesh = std::move(mesh);
+  return t;
+}
+
+Target load_target(const std::string& mesh_path, const std::string& scene_path) {
+  if (mesh_path.empty() == scene_path.empty()) throw InputError("give exactly one of --mesh and --scene");
+  if (!scene_path.empty()) throw InputError(scene_path + ": scenes are not supported yet");
+  return mesh_target(std::make_shared<const Mesh>(read_mesh(mesh_path)), mesh_path);
+}
+
+std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name, Params params,
+                                                     const std::string& top, const std::string& bottom) {
+  if (!target.mesh) throw InputError(target.path + ": scenes are not supported yet");
+  if (!top.empty() || !bottom.empty())
+    throw InputError("--accel-top and --accel-bottom apply to scenes only (" + target.path + " is a mesh)");
+  return make_accelerator(name, std::make_shared<const TrianglePrims>(target.mesh), std::move(params));
+}
+
+namespace {
+/// The structure used to find surface points when making rays: the project's own SAH BVH where it is
+/// registered (deterministic, identical to brute), else brute force.
+std::string ray_generation_accelerator() {
+  for (const auto& info : accelerators())
+    if (info.name == "bvh-sah") return info.name;
+  return "brute";
+}
+}  // namespace
+
+RayTarget ray_target(const Target& target) {
+  if (!target.mesh) throw InputError(target.path + ": scenes are not supported yet");
+  std::unique_ptr<Accelerator> built = make_target_accelerator(target, ray_generation_accelerator(), Params{});
+  built->build();
+  std::shared_ptr<const Accelerator> accel = std::move(built);
+  RayTarget rt;
+  rt.bounds = target.bounds;
+  rt.trace = [accel](std::span<const Ray> rays, std::span<Hit> hits) { accel->intersect(rays, hits); };
+  const std::shared_ptr<const Mesh> mesh = target.mesh;
+  rt.normal = [mesh](const Hit& h) {
+    const Triangle t = mesh->triangle(h.prim);
+    const vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
+    const float len = glm::length(n);
+    return len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
+  };
+  return rt;
+}
+
+HitTriangleFn hit_triangles(const Target& target) {
+  if (!target.mesh) throw InputError(target.path + ": scenes are not supported yet");
+  const std::shared_ptr<const Mesh> mesh = target.mesh;
+  return [mesh](const Hit& h) { return mesh->triangle(h.prim); };
+}
+
+}  // namespace ab
