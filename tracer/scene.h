@@ -1,0 +1,72 @@
+// Scenes: base meshes (loaded once), instances of them under transforms, materials, lights and a
+// camera, read from the XML format described in docs/scenes.md.
+#pragma once
+
+#include "accel/mesh.h"
+#include "tracer/camera.h"
+#include "tracer/light.h"
+#include "tracer/material.h"
+#include "tracer/transform.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ab {
+
+/// A base mesh, declared once and shared by every instance that names it.
+struct SceneMesh {
+  std::string name;
+  std::string source;  ///< "file PATH", "generator NAME ..." or "inline" (for reports)
+  std::shared_ptr<const Mesh> mesh;
+};
+
+/// One placement of a base mesh. Its index in Scene::instances is its `inst` id (document order).
+struct SceneInstance {
+  uint32_t mesh = 0;      ///< index into Scene::meshes
+  uint32_t material = 0;  ///< index into Scene::materials
+  Transform transform;
+};
+
+/// Defaults for `accelbench render` (command-line options override them).
+struct RenderSettings {
+  int width = 256;
+  int height = 256;
+  int spp = 16;           ///< samples per pixel
+  int max_depth = 6;      ///< recursion limit (specular, glossy and diffuse bounces)
+  int diffuse_depth = 1;  ///< how many of those bounces may be diffuse (indirect light)
+  vec3 background{0.0f};  ///< radiance of rays that leave the scene
+  vec3 ambient{0.0f};     ///< constant light added on diffuse surfaces
+};
+
+/// A whole scene.
+struct Scene {
+  std::string path;  ///< the file it came from (for messages)
+  std::vector<SceneMesh> meshes;
+  std::vector<SceneInstance> instances;
+  std::vector<Material> materials;  ///< materials[0] is the default ("default", grey diffuse)
+  std::vector<PointLight> point_lights;
+  std::vector<AreaLight> area_lights;
+  Camera camera;
+  RenderSettings render;
+
+  /// World-space triangles over all instances.
+  uint64_t triangle_count() const;
+  /// World bounds of all instances (transformed mesh vertices).
+  AABB world_bounds() const;
+  /// World-space geometric normal (unnormalized, by the inverse transpose) of a hit.
+  vec3 hit_normal(const Hit& hit) const;
+};
+
+/// Reads a scene file. Mesh files are resolved relative to the scene file's folder. Throws InputError
+/// naming the file and line for malformed XML, unknown elements or references, bad numbers, missing
+/// or malformed meshes and singular transforms.
+Scene load_scene(const std::string& path);
+/// Parses scene text; `path` names it in messages and `base_dir` resolves mesh files.
+Scene parse_scene(const std::string& text, const std::string& path, const std::string& base_dir);
+
+/// The scene as one world-space mesh: instances in document order, each instance's triangles in
+/// base-mesh order (vertices of every instance transformed by its object-to-world matrix).
+Mesh flatten_scene(const Scene& scene);
+
+}  // namespace ab
