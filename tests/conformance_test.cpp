@@ -1,0 +1,267 @@
+// Every registered structure of the project against brute force: byte-identical hits, the same
+// occlusion answers, at 1 and 2 threads, as bottom and as top level, on adversarial meshes and rays,
+// on every generator and ray kind, and on the real meshes. New structures are covered by registering.
+#include "accel/brute.h"
+#include "accel/registry.h"
+#include "accel/trace.h"
+#include "datasets/generators.h"
+#include "datasets/mesh_io.h"
+#include "datasets/random.h"
+#include "datasets/rays.h"
+#include "harness/compare.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+
+namespace ab {
+namespace {
+
+std::vector<std::string> structure_names() {
+  std::vector<std::string> names;
+  for (const auto& info : accelerators())
+    if (!info.is_reference && info.name.rfind("test-", 0) != 0) names.push_back(info.name);
+  if (names.empty()) names.push_back("brute");  // keeps the suite non-empty before structures land
+  return names;
+}
+
+std::shared_ptr<const Mesh> share(Mesh m) { return std::make_shared<const Mesh>(std::move(m)); }
+
+void add_triangle(Mesh& m, vec3 a, vec3 b, vec3 c) {
+  const uint32_t base = static_cast<uint32_t>(m.vertices.size());
+  m.vertices.insert(m.vertices.end(), {a, b, c});
+  m.triangles.push_back({base, base + 1, base + 2});
+}
+
+/// Axis-aligned unit cubes on an integer lattice: faces lie exactly on likely split planes, and
+/// neighbouring cubes share faces (coplanar duplicates with opposite orientation).
+Mesh lattice_cubes() {
+  Mesh m;
+  for (int x = 0; x < 3; ++x)
+    for (int y = 0; y < 3; ++y)
+      for (int z = 0; z < 2; ++z) {
+        if ((x + y + z) % 2) continue;
+        const vec3 o(x, y, z);
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = 0; side < 2; ++side) {
+            vec3 a(0), b(0), c(0), d(0);
+            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            a[axis] = b[axis] = c[axis] = d[axis] = float(side);
+            b[u] = 1;
+            c[u] = 1;
+            c[v] = 1;
+            d[v] = 1;
+            add_triangle(m, o + a, o + b, o + c);
+            add_triangle(m, o + a, o + c, o + d);
+          }
+      }
+  return m;
+}
+
+/// Flat geometry: every triangle in the plane z = 0.5 (a zero-thickness bounding box).
+Mesh flat_sheet() {
+  Mesh m;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const vec3 o(i, j, 0.5f);
+      add_triangle(m, o, o + vec3(1, 0, 0), o + vec3(1, 1, 0));
+      add_triangle(m, o, o + vec3(1, 1, 0), o + vec3(0, 1, 0));
+    }
+  return m;
+}
+
+/// Duplicates, degenerate triangles (points, repeated vertices, collinear) and a tiny object in a huge box.
+Mesh nasty_mix() {
+  Mesh m;
+  Rng rng(7);
+  for (int i = 0; i < 40; ++i) {
+    const vec3 a = rng.unit_cube(), b = rng.unit_cube(), c = rng.unit_cube();
+    add_triangle(m, a, b, c);
+    if (i % 5 == 0) add_triangle(m, a, b, c);          // exact duplicate
+    if (i % 7 == 0) add_triangle(m, a, a, a);          // point
+    if (i % 6 == 0) add_triangle(m, a, b, b);          // repeated vertex
+    if (i % 9 == 0) add_triangle(m, a, 0.5f * (a + b), b);  // collinear
+  }
+  add_triangle(m, {-1000, -1000, -1000}, {1000, -1000, -1000}, {1000, 1000, -1000});  // the stadium floor
+  add_triangle(m, {0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f});
+  return m;
+}
+
+Mesh one_triangle() {
+  Mesh m;
+  add_triangle(m, {0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  return m;
+}
+
+/// Adversarial rays for a mesh: random, axis-parallel (zero components, +0 and -0), aimed at vertices and
+/// edge midpoints, starting on surfaces, lying in axis planes through vertices, and with tmin/tmax cut at
+/// the brute-force hit distance.
+std::vector<Ray> adversarial_rays(const Mesh& mesh, const AABB& box, uint64_t seed) {
+  std::vector<Ray> rays;
+  Rng rng(seed);
+  const AABB b = box.empty() ? AABB{vec3(0), vec3(1)} : box;
+  const vec3 lo = b.lo - 0.25f * (b.extent() + vec3(1)), hi = b.hi + 0.25f * (b.extent() + vec3(1));
+  auto point = [&] { return lo + rng.unit_cube() * (hi - lo); };
+  for (int i = 0; i < 300; ++i) rays.push_back({point(), rng.unit_sphere(), 0.0f, kInf});
+  for (int i = 0; i < 300; ++i) {  // axis-parallel rays, also with -0 components
+    Ray r{point(), vec3(0.0f), 0.0f, kInf};
+    const int axis = i % 3;
+    r.dir[axis] = (i / 3) % 2 ? 1.0f : -1.0f;
+    if (i % 4 == 0) r.dir[(axis + 1) % 3] = -0.0f;
+    rays.push_back(r);
+  }
+  for (size_t t = 0; t < mesh.size() && rays.size() < 2400; t += 1 + mesh.size() / 400) {
+    const Triangle tri = mesh.triangle(t);
+    const vec3 targets[4] = {tri.v0, 0.5f * (tri.v0 + tri.v1), 0.5f * (tri.v1 + tri.v2), tri.centroid()};
+    for (const vec3& target : targets) {
+      const vec3 o = point();
+      rays.push_back({o, target - o, 0.0f, kInf});  // at a vertex / edge / centre, t = 1
+    }
+    rays.push_back({tri.centroid(), rng.unit_sphere(), 0.0f, kInf});  // starting on the surface
+    Ray in_plane{tri.v0 - vec3(b.extent().x + 1, 0, 0), vec3(1, 0, 0), 0.0f, kInf};  // in the axis planes of v0
+    rays.push_back(in_plane);
+    Ray limited{point(), tri.centroid(), 0.0f, 1.0f};
+    limited.dir = tri.centroid() - limited.org;
+    rays.push_back(limited);  // tmax exactly at the hit
+    limited.tmin = 1.0f;
+    limited.tmax = kInf;
+    rays.push_back(limited);  // tmin exactly at the hit
+  }
+  rays.push_back({b.center(), vec3(0.0f), 0.0f, kInf});  // zero direction
+  return rays;
+}
+
+std::string hit_string(const Hit& h) {
+  return "t=" + std::to_string(h.t) + " prim=" + std::to_string(h.prim) + " inst=" + std::to_string(h.inst) +
+         " u=" + std::to_string(h.u) + " v=" + std::to_string(h.v);
+}
+
+/// Traces rays with `name` at 1 and 2 threads (closest, counted, occluded) and expects brute's bits.
+void expect_same_as_brute(const Accelerator& accel, const Accelerator& brute, const std::vector<Ray>& rays,
+                          const std::string& what) {
+  std::vector<Hit> expected(rays.size());
+  trace_closest(brute, rays, expected, 1);
+  for (int threads : {1, 2}) {
+    std::vector<Hit> hits(rays.size());
+    trace_closest(accel, rays, hits, threads);
+    const IdenticalResult r = compare_identical(expected, hits);
+    ASSERT_TRUE(r.identical()) << what << ", " << threads << " thread(s): " << r.differing << " of " << rays.size()
+                               << " rays differ; first ray " << r.first_differences.front()
+                               << ": expected " << hit_string(expected[r.first_differences.front()]) << ", got "
+                               << hit_string(hits[r.first_differences.front()]);
+  }
+  std::vector<Hit> counted(rays.size());
+  const RayCounters c = trace_closest_counted(accel, rays, counted, 2);
+  EXPECT_TRUE(compare_identical(expected, counted).identical()) << what << ": the counting pass changed hits";
+  EXPECT_GT(c.prims + c.nodes + (rays.empty() ? 1 : 0) + (accel.bounds().empty() ? 1 : 0), 0u) << what;
+  std::vector<uint8_t> occluded(rays.size());
+  trace_occluded(accel, rays, occluded, 2);
+  for (size_t i = 0; i < rays.size(); ++i)
+    ASSERT_EQ(occluded[i] != 0, expected[i].found()) << what << ": occluded() disagrees with brute on ray " << i;
+}
+
+void check_mesh(const std::string& name, std::shared_ptr<const Mesh> mesh, const std::vector<Ray>& rays,
+                const std::string& what) {
+  auto prims = std::make_shared<const TrianglePrims>(mesh);
+  auto accel = make_accelerator(name, prims, Params{});
+  accel->build();
+  auto brute = make_accelerator("brute", prims, Params{});
+  brute->build();
+  expect_same_as_brute(*accel, *brute, rays, what);
+}
+
+class Conformance : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Conformance, AdversarialMeshesAndRays) {
+  const std::vector<std::pair<std::string, Mesh>> meshes = {{"empty mesh", Mesh{}},
+                                                            {"one triangle", one_triangle()},
+                                                            {"flat sheet", flat_sheet()},
+                                                            {"lattice cubes", lattice_cubes()},
+                                                            {"duplicates and degenerates", nasty_mix()}};
+  for (const auto& [what, mesh] : meshes) {
+    auto shared = share(mesh);
+    check_mesh(GetParam(), shared, adversarial_rays(mesh, mesh.bounds(), 11), what);
+  }
+}
+
+TEST_P(Conformance, EveryGeneratorAndRayKind) {
+  ASSERT_FALSE(generators().empty());
+  for (const auto& gen : generators()) {
+    auto mesh = share(generate_mesh(gen.name, 3000, 5, Params{}));
+    auto prims = std::make_shared<const TrianglePrims>(mesh);
+    auto brute = make_accelerator("brute", prims, Params{});
+    brute->build();
+    RayTarget target;
+    target.bounds = mesh->bounds();
+    target.trace = [&](std::span<const Ray> r, std::span<Hit> h) { brute->intersect(r, h); };
+    target.normal = [&](const Hit& h) {
+      const Triangle t = mesh->triangle(h.prim);
+      const vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
+      return glm::length(n) > 0 ? glm::normalize(n) : vec3(0, 0, 1);
+    };
+    auto accel = make_accelerator(GetParam(), prims, Params{});
+    accel->build();
+    for (const auto& kind : ray_kinds()) {
+      const std::vector<Ray> rays = make_rays(kind.name, target, 1500, 3);
+      expect_same_as_brute(*accel, *brute, rays, gen.name + " / " + kind.name);
+    }
+    expect_same_as_brute(*accel, *brute, adversarial_rays(*mesh, mesh->bounds(), 13), gen.name + " / adversarial");
+  }
+}
+
+TEST_P(Conformance, RealMeshes) {
+  const std::filesystem::path dir = std::filesystem::path(ACCELBENCH_SOURCE_DIR) / ".." / "shared" / "meshes";
+  if (!std::filesystem::exists(dir / "teapot.obj")) GTEST_SKIP() << "the real meshes are not at " << dir;
+  for (const char* file : {"teapot.obj", "stanford-bunny.obj"}) {
+    auto mesh = share(read_mesh((dir / file).string()));
+    check_mesh(GetParam(), mesh, adversarial_rays(*mesh, mesh->bounds(), 17), file);
+  }
+}
+
+/// The structure as the top level over instances (bottoms: brute), and as the bottom level (top: brute).
+TEST_P(Conformance, BothLevelsOfInstancing) {
+  const AcceleratorInfo& info = find_accelerator(GetParam());
+  auto mesh = share(lattice_cubes());
+  auto prims = std::make_shared<const TrianglePrims>(mesh);
+  std::shared_ptr<Accelerator> base_brute = make_accelerator("brute", prims, Params{});
+  base_brute->build();
+  std::shared_ptr<Accelerator> base_accel = make_accelerator(GetParam(), prims, Params{});
+  base_accel->build();
+  auto instances_over = [&](std::shared_ptr<const Accelerator> base) {
+    std::vector<Instance> list;
+    for (int i = 0; i < 12; ++i) {
+      glm::mat4 m(1.0f);
+      m = glm::translate(m, vec3(float(i % 4) * 2.5f, float(i / 4) * 3.0f, float(i % 3)));
+      m = glm::rotate(m, 0.3f * float(i), glm::normalize(vec3(1, 2, 3)));
+      m = glm::scale(m, vec3(1.0f + 0.1f * float(i), 0.5f + 0.05f * float(i), 1.0f));
+      if (i == 5) m = glm::translate(glm::mat4(1.0f), vec3(2.5f, 3.0f, 2.0f));  // exact overlap with another
+      list.push_back({base, m, glm::inverse(m), 0});
+    }
+    return std::make_shared<const InstancePrims>(std::move(list));
+  };
+  auto all_brute = make_instance_accelerator("brute", instances_over(base_brute), Params{});
+  all_brute->build();
+  const AABB world = all_brute->bounds();
+  const std::vector<Ray> rays = adversarial_rays(Mesh{}, world, 19);
+  if (info.make_for_instances) {
+    auto top = make_instance_accelerator(GetParam(), instances_over(base_brute), Params{});
+    top->build();
+    expect_same_as_brute(*top, *all_brute, rays, "as top level");
+  }
+  auto bottom = make_instance_accelerator("brute", instances_over(base_accel), Params{});
+  bottom->build();
+  expect_same_as_brute(*bottom, *all_brute, rays, "as bottom level");
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, Conformance, ::testing::ValuesIn(structure_names()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string s = info.param;
+                           for (char& c : s)
+                             if (c == '-') c = '_';
+                           return s;
+                         });
+
+}  // namespace
+}  // namespace ab
