@@ -1,0 +1,113 @@
+// The compact k-d tree node (8 bytes, as in pbrt: Pharr, Jakob and Humphreys, "Physically Based Rendering",
+// section 4.4), the flat node/primitive-index buffers every k-d builder writes, and the conservative
+// insertion helpers shared by the k-d builders.
+#pragma once
+
+#include "accel/geometry.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace ab {
+
+/// One k-d tree node: an interior node (axis, split coordinate, index of the above child; the below
+/// child follows it directly) or a leaf (offset and count of its primitive indices).
+class KdNode {
+ public:
+  /// A leaf of `count` primitive indices starting at `first`.
+  static KdNode leaf(uint32_t first, uint32_t count) { return KdNode(first, (count << 2) | 3u); }
+  /// An interior node splitting `axis` at `split`; the above child is node `above`.
+  static KdNode interior(int axis, float split, uint32_t above) {
+    return KdNode(std::bit_cast<uint32_t>(split), (above << 2) | uint32_t(axis));
+  }
+
+  /// True for a leaf.
+  bool is_leaf() const { return (bits_ & 3u) == 3u; }
+  /// Split axis (interior nodes).
+  int axis() const { return int(bits_ & 3u); }
+  /// Split coordinate (interior nodes).
+  float split() const { return std::bit_cast<float>(word_); }
+  /// Index of the above child (interior nodes); the below child is this node's index + 1.
+  uint32_t above() const { return bits_ >> 2; }
+  /// First primitive index (leaves).
+  uint32_t first() const { return word_; }
+  /// Number of primitives (leaves).
+  uint32_t count() const { return bits_ >> 2; }
+  /// Moves the node by `node_base` nodes and `prim_base` primitive indices (splicing buffers).
+  void rebase(uint32_t node_base, uint32_t prim_base) {
+    if (is_leaf()) {
+      word_ += prim_base;
+    } else {
+      bits_ += node_base << 2;
+    }
+  }
+
+ private:
+  KdNode(uint32_t word, uint32_t bits) : word_(word), bits_(bits) {}
+  uint32_t word_;
+  uint32_t bits_;
+};
+static_assert(sizeof(KdNode) == 8);
+
+/// Largest node index or primitive count a KdNode can hold.
+inline constexpr uint32_t kKdMaxIndex = (1u << 30) - 1;
+
+/// Nodes in depth-first order (below child next to its parent) and the leaves' primitive indices.
+struct KdBuffer {
+  std::vector<KdNode> nodes;
+  std::vector<uint32_t> prims;
+
+  /// Appends a leaf holding ids.
+  void add_leaf(const std::vector<uint32_t>& ids) {
+    nodes.push_back(KdNode::leaf(uint32_t(prims.size()), uint32_t(ids.size())));
+    prims.insert(prims.end(), ids.begin(), ids.end());
+  }
+  /// Appends a subtree built into its own buffer (parallel builds), fixing its indices.
+  void append(const KdBuffer& sub) {
+    const uint32_t node_base = uint32_t(nodes.size());
+    const uint32_t prim_base = uint32_t(prims.size());
+    for (KdNode n : sub.nodes) {
+      n.rebase(node_base, prim_base);
+      nodes.push_back(n);
+    }
+    prims.insert(prims.end(), sub.prims.begin(), sub.prims.end());
+  }
+};
+
+/// Margin of conservative insertion for a node box: a primitive within it of a split plane goes to both
+/// children. Same scale as inflate_for_insertion (clip.h): relative to the box's size and position.
+inline float insertion_margin(const AABB& box) {
+  const vec3 e = box.extent();
+  const vec3 a = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+  return std::max({e.x, e.y, e.z, a.x, a.y, a.z}) * 0x1p-18f;
+}
+
+/// The part of primitive i that a child box holds for the builders: its perfect-split bounds in the child
+/// box grown by `margin`, clamped back into the child box (so a primitive that only comes within the
+/// margin becomes a flat sliver on the child's face instead of disappearing).
+template <class P>
+AABB clip_into_child(const P& prims, uint32_t i, const AABB& child, float margin) {
+  const AABB grown{child.lo - vec3(margin), child.hi + vec3(margin)};
+  AABB cb = prims.clipped_bounds(i, grown);
+  if (cb.empty()) cb = AABB::intersection(prims.bounds(i), grown);
+  cb.lo = glm::clamp(cb.lo, child.lo, child.hi);
+  cb.hi = glm::clamp(cb.hi, child.lo, child.hi);
+  cb.lo = glm::min(cb.lo, cb.hi);
+  return cb;
+}
+
+/// True when every coordinate of b is finite (primitives with NaN or infinite bounds are never hit
+/// and are left out of spatial structures).
+inline bool finite_box(const AABB& b) {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a])) return false;
+  return !b.empty();
+}
+
+/// Default depth limit of the k-d builders: 8 + 1.3 log2 N (Havran 2000; pbrt).
+inline int auto_kd_depth(size_t n) { return int(std::lround(8.0 + 1.3 * std::log2(double(std::max<size_t>(n, 1))))); }
+
+}  // namespace ab
