@@ -3,6 +3,8 @@
 #include "accel/error.h"
 #include "accel/registry.h"
 #include "datasets/mesh_io.h"
+#include "tracer/scene.h"
+#include "tracer/scene_accel.h"
 
 namespace ab {
 
@@ -17,13 +19,21 @@ Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name) {
 
 Target load_target(const std::string& mesh_path, const std::string& scene_path) {
   if (mesh_path.empty() == scene_path.empty()) throw InputError("give exactly one of --mesh and --scene");
-  if (!scene_path.empty()) throw InputError(scene_path + ": scenes are not supported yet");
+  if (!scene_path.empty()) {
+    Target t;
+    t.path = scene_path;
+    auto scene = std::make_shared<const Scene>(load_scene(scene_path));
+    t.triangles = scene->triangle_count();
+    t.bounds = scene->world_bounds();
+    t.scene = std::move(scene);
+    return t;
+  }
   return mesh_target(std::make_shared<const Mesh>(read_mesh(mesh_path)), mesh_path);
 }
 
 std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name, Params params,
                                                      const std::string& top, const std::string& bottom) {
-  if (!target.mesh) throw InputError(target.path + ": scenes are not supported yet");
+  if (target.scene) return make_scene_accelerator(target.scene, name, std::move(params), top, bottom);
   if (!top.empty() || !bottom.empty())
     throw InputError("--accel-top and --accel-bottom apply to scenes only (" + target.path + " is a mesh)");
   return make_accelerator(name, std::make_shared<const TrianglePrims>(target.mesh), std::move(params));
@@ -40,13 +50,21 @@ std::string ray_generation_accelerator() {
 }  // namespace
 
 RayTarget ray_target(const Target& target) {
-  if (!target.mesh) throw InputError(target.path + ": scenes are not supported yet");
   std::unique_ptr<Accelerator> built = make_target_accelerator(target, ray_generation_accelerator(), Params{});
   built->build();
   std::shared_ptr<const Accelerator> accel = std::move(built);
   RayTarget rt;
   rt.bounds = target.bounds;
   rt.trace = [accel](std::span<const Ray> rays, std::span<Hit> hits) { accel->intersect(rays, hits); };
+  if (target.scene) {
+    const std::shared_ptr<const Scene> scene = target.scene;
+    rt.normal = [scene](const Hit& h) {
+      const vec3 n = scene->hit_normal(h);
+      const float len = glm::length(n);
+      return len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
+    };
+    return rt;
+  }
   const std::shared_ptr<const Mesh> mesh = target.mesh;
   rt.normal = [mesh](const Hit& h) {
     const Triangle t = mesh->triangle(h.prim);
@@ -58,7 +76,14 @@ RayTarget ray_target(const Target& target) {
 }
 
 HitTriangleFn hit_triangles(const Target& target) {
-  if (!target.mesh) throw InputError(target.path + ": scenes are not supported yet");
+  if (target.scene) {
+    const std::shared_ptr<const Scene> scene = target.scene;
+    return [scene](const Hit& h) {
+      const SceneInstance& inst = scene->instances.at(h.inst);
+      const Triangle t = scene->meshes[inst.mesh].mesh->triangle(h.prim);
+      return Triangle{inst.transform.point(t.v0), inst.transform.point(t.v1), inst.transform.point(t.v2)};
+    };
+  }
   const std::shared_ptr<const Mesh> mesh = target.mesh;
   return [mesh](const Hit& h) { return mesh->triangle(h.prim); };
 }

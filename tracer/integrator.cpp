@@ -2,6 +2,7 @@
 
 #include "tracer/camera.h"
 #include "tracer/sampling.h"
+#include "tracer/workload.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -52,11 +53,7 @@ class PixelSampler {
 class Tracer {
  public:
   Tracer(const Scene& scene, const Accelerator& accel, const RenderOptions& opt)
-      : scene_(scene), accel_(accel), opt_(opt) {
-    const AABB b = accel.bounds();
-    const float scale = b.empty() ? 1.0f : glm::length(b.extent()) + glm::length(glm::max(glm::abs(b.lo), glm::abs(b.hi)));
-    eps_ = 2e-5f * std::max(scale, 1e-3f);
-  }
+      : scene_(scene), accel_(accel), opt_(opt), eps_(surface_epsilon(accel.bounds())) {}
 
   /// Radiance arriving along ray. `see_lights`: whether area lights seen directly count (not after a
   /// diffuse bounce, whose light is sampled explicitly).
@@ -88,7 +85,7 @@ class Tracer {
       refract_or_reflect(p, d, nf, front ? 1.0f / m.ior : m.ior, s.next1(), next);
     }
     ++n.secondary_rays;
-    return m.color * radiance(next, depth + 1, diffuse_left, true, s, n);
+    return m.color * radiance(next, depth + 1, diffuse_left, see_lights, s, n);
   }
 
  private:

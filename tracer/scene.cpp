@@ -37,7 +37,9 @@ class SceneParser {
                                                       std::string(root.name()) + ">");
     check_attributes(root, {});
     scene_.path = path_;
-    scene_.materials.push_back(Material{.name = "default"});
+    Material fallback;
+    fallback.name = "default";
+    scene_.materials.push_back(fallback);
     material_index_["default"] = 0;
     for (pugi::xml_node n : root.children()) declaration(n);
     for (pugi::xml_node n : root.children("instance")) instance(n);
