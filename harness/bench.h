@@ -1,0 +1,56 @@
+// Timing through Google Benchmark: each case is registered at run time, timed manually (only the part
+// the caller measures, for example the traversal loop), repeated, and summarized by the library's own
+// statistics (median, mean, stddev, plus min and max). Every run is kept for DIR/gbench.json, which the
+// library's tools (compare.py) read.
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace ab {
+
+/// Seconds per pass over the repetitions of one case.
+struct Timing {
+  double median = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+  double mean = 0.0;
+  double stddev = 0.0;
+  int repetitions = 0;
+  int64_t iterations = 0;  ///< passes per repetition
+};
+
+/// Passes per repetition so that a repetition lasts at least `min_time` seconds, given one pass's time.
+int64_t iterations_for(double pass_seconds, double min_time);
+
+/// Runs cases through Google Benchmark one at a time (so that only one structure is alive at a time)
+/// and keeps every reported run.
+class BenchTimer {
+ public:
+  BenchTimer();
+  ~BenchTimer();
+  BenchTimer(const BenchTimer&) = delete;
+  BenchTimer& operator=(const BenchTimer&) = delete;
+
+  /// Times `pass`, which does one unit of work and returns the seconds of the part to count (manual
+  /// timing), `iterations` times per repetition. `items` (rays, triangles) per pass gives the
+  /// library's items_per_second; `counters` are attached to the case in gbench.json. Exceptions thrown
+  /// by `pass` are rethrown after the library has finished the case.
+  Timing time(const std::string& name, int repetitions, int64_t iterations,
+              const std::function<double()>& pass, double items = 0.0,
+              const std::map<std::string, double>& counters = {});
+
+  /// Google Benchmark's JSON (context and every run so far), as its JSONReporter writes it.
+  std::string json() const;
+
+ private:
+  class Collector;
+  Collector* collector_;
+};
+
+}  // namespace ab

@@ -1,0 +1,30 @@
+// Running a suite: scenes are made one at a time, every accelerator configuration is built (timed over
+// the repetitions), verified against brute force, the verified reference structure and Embree, and
+// timed through Google Benchmark at each thread count; counters come from a separate counting pass.
+#pragma once
+
+#include <atomic>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "harness/suite.h"
+
+namespace ab {
+
+/// How to run a suite.
+struct RunOptions {
+  std::string out_dir;                             ///< where report.json, report.csv and gbench.json go
+  bool progress = false;                           ///< draw the progress bar on stderr
+  bool color = false;                              ///< red failure lines on stderr
+  const std::atomic<bool>* interrupted = nullptr;  ///< set by SIGINT: stop after the current case
+};
+
+/// Runs the suite and returns the report (also written to out_dir after every scene and at the end,
+/// with gbench.json beside it). report["verified"] is false when any check failed; report["interrupted"]
+/// is true when the run stopped early (finished cases are kept).
+nlohmann::json run_suite(const Suite& suite, const RunOptions& options);
+
+/// Pearson's correlation coefficient of two equally long series (NaN when undefined).
+double pearson(const std::vector<double>& x, const std::vector<double>& y);
+
+}  // namespace ab
