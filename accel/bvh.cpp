@@ -1,0 +1,292 @@
+#include "accel/bvh.h"
+
+#include "accel/registry.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <numeric>
+
+namespace ab {
+
+namespace {
+
+/// Ranges at least this large compute their bounds and bins with a parallel reduction. The reductions
+/// use only min, max and integer sums, which are exact, so the result does not depend on the split.
+constexpr size_t kParallelReduceThreshold = 1u << 16;
+constexpr size_t kGrain = 1u << 12;
+
+/// Bounds of the primitives of a range and of their centroids.
+struct RangeBounds {
+  AABB bounds;
+  AABB centroids;
+
+  void merge(const RangeBounds& o) {
+    bounds.extend(o.bounds);
+    centroids.extend(o.centroids);
+  }
+};
+
+/// The builder: recursion over ranges of the reference array `order_`. A node for range [b, e) is
+/// written at slot p of a gapped array of 2N-1 slots; its left child is at p+1 and its right child at
+/// p + 2 (m - b), so disjoint subtrees never share slots and can be built in parallel. flatten() then
+/// compacts the slots into the final depth-first array.
+class BvhBuilder {
+ public:
+  BvhBuilder(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids)
+      : method_(method), config_(config), bounds_(bounds), centroids_(centroids), order_(bounds.size()),
+        slots_(bounds.empty() ? 0 : 2 * bounds.size() - 1) {
+    std::iota(order_.begin(), order_.end(), 0u);
+  }
+
+  /// Builds the tree and returns the flattened result.
+  BvhBuildResult run() {
+    if (!order_.empty()) build(0, 0, uint32_t(order_.size()), 0);
+    return flatten();
+  }
+
+ private:
+  void build(uint32_t p, uint32_t b, uint32_t e, int depth);
+  RangeBounds range_bounds(uint32_t b, uint32_t e) const;
+  uint32_t choose_split(uint32_t b, uint32_t e, const RangeBounds& rb);
+  uint32_t split_median(uint32_t b, uint32_t e, const RangeBounds& rb);
+  uint32_t split_binned(uint32_t b, uint32_t e, const RangeBounds& rb);
+  uint32_t split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb);
+  std::vector<SahBin> bin_range(uint32_t b, uint32_t e, const BinMapping& map) const;
+  uint32_t decide(uint32_t b, uint32_t e, const SahSplit& best) const;
+  BvhBuildResult flatten() const;
+
+  BvhMethod method_;
+  BvhConfig config_;
+  std::span<const AABB> bounds_;
+  std::span<const vec3> centroids_;
+  std::vector<uint32_t> order_;
+  std::vector<BvhNode> slots_;
+};
+
+void BvhBuilder::build(uint32_t p, uint32_t b, uint32_t e, int depth) {
+  const RangeBounds rb = range_bounds(b, e);
+  BvhNode& node = slots_[p];
+  for (int a = 0; a < 3; ++a) {
+    node.lo[a] = rb.bounds.lo[a];
+    node.hi[a] = rb.bounds.hi[a];
+  }
+  const uint32_t m = (depth >= config_.max_depth || e - b == 1) ? b : choose_split(b, e, rb);
+  if (m == b) {  // leaf
+    node.offset = b;
+    node.count = e - b;
+    return;
+  }
+  const uint32_t left = p + 1, right = p + 2 * (m - b);
+  node.offset = right;
+  node.count = 0;
+  if (e - b >= config_.parallel_threshold) {
+    tbb::parallel_invoke([&] { build(left, b, m, depth + 1); }, [&] { build(right, m, e, depth + 1); });
+  } else {
+    build(left, b, m, depth + 1);
+    build(right, m, e, depth + 1);
+  }
+}
+
+RangeBounds BvhBuilder::range_bounds(uint32_t b, uint32_t e) const {
+  auto body = [&](const tbb::blocked_range<uint32_t>& r, RangeBounds acc) {
+    for (uint32_t k = r.begin(); k < r.end(); ++k) {
+      acc.bounds.extend(bounds_[order_[k]]);
+      acc.centroids.extend(centroids_[order_[k]]);
+    }
+    return acc;
+  };
+  if (e - b < kParallelReduceThreshold) return body({b, e}, RangeBounds{});
+  return tbb::parallel_reduce(tbb::blocked_range<uint32_t>(b, e, kGrain), RangeBounds{}, body,
+                              [](RangeBounds x, const RangeBounds& y) {
+                                x.merge(y);
+                                return x;
+                              });
+}
+
+/// Returns the split index m in (b, e), or b for a leaf.
+uint32_t BvhBuilder::choose_split(uint32_t b, uint32_t e, const RangeBounds& rb) {
+  switch (method_) {
+    case BvhMethod::kMedian:
+      return split_median(b, e, rb);
+    case BvhMethod::kBinnedSah:
+      return split_binned(b, e, rb);
+    case BvhMethod::kSweepSah:
+      return split_sweep(b, e, rb);
+  }
+  return b;
+}
+
+// Object median: sort-free selection (nth_element) of the centroid median along the longest axis of
+// the centroid bounds; ties broken by id so the result is a function of the range alone.
+uint32_t BvhBuilder::split_median(uint32_t b, uint32_t e, const RangeBounds& rb) {
+  const uint32_t n = e - b;
+  if (n <= uint32_t(config_.max_leaf_size)) return b;
+  const int axis = rb.centroids.longest_axis();
+  const uint32_t m = b + n / 2;
+  if (!(rb.centroids.extent()[axis] > 0.0f)) return m;  // all centroids coincide: split by position
+  std::nth_element(order_.begin() + b, order_.begin() + m, order_.begin() + e, [&](uint32_t x, uint32_t y) {
+    const float cx = centroids_[x][axis], cy = centroids_[y][axis];
+    return cx != cy ? cx < cy : x < y;
+  });
+  return m;
+}
+
+/// Leaf or split given the best SAH split: a leaf when the SAH says splitting does not pay and the node
+/// is small enough; a forced split in the middle when no valid split exists but the node is too big.
+uint32_t BvhBuilder::decide(uint32_t b, uint32_t e, const SahSplit& best) const {
+  const uint32_t n = e - b;
+  const bool small = n <= uint32_t(config_.max_leaf_size);
+  if (best.axis < 0) return small ? b : b + n / 2;
+  if (small && best.cost >= config_.costs.leaf(n)) return b;
+  return e;  // "split as found"
+}
+
+std::vector<SahBin> BvhBuilder::bin_range(uint32_t b, uint32_t e, const BinMapping& map) const {
+  const size_t nb = size_t(map.bins);
+  auto body = [&](const tbb::blocked_range<uint32_t>& r, std::vector<SahBin> acc) {
+    if (acc.empty()) acc.resize(3 * nb);
+    for (uint32_t k = r.begin(); k < r.end(); ++k) {
+      const uint32_t id = order_[k];
+      for (int a = 0; a < 3; ++a) acc[a * nb + map.bin(a, centroids_[id][a])].add(bounds_[id]);
+    }
+    return acc;
+  };
+  if (e - b < kParallelReduceThreshold) return body({b, e}, std::vector<SahBin>(3 * nb));
+  return tbb::parallel_reduce(tbb::blocked_range<uint32_t>(b, e, kGrain), std::vector<SahBin>(3 * nb), body,
+                              [](std::vector<SahBin> x, const std::vector<SahBin>& y) {
+                                for (size_t i = 0; i < x.size(); ++i) x[i].merge(y[i]);
+                                return x;
+                              });
+}
+
+// Binned SAH (Wald 2007): centroids are projected into equal-width bins on each axis, the bins are
+// swept to evaluate every bin boundary, and the range is partitioned at the cheapest one.
+uint32_t BvhBuilder::split_binned(uint32_t b, uint32_t e, const RangeBounds& rb) {
+  const BinMapping map(rb.centroids, config_.bins);
+  const std::vector<SahBin> bins = bin_range(b, e, map);
+  SahSplit best;
+  const float area = rb.bounds.area();
+  for (int a = 0; a < 3; ++a)
+    if (map.scale[a] > 0.0f) best_bin_split(&bins[a * size_t(map.bins)], map.bins, a, area, config_.costs, best);
+  const uint32_t d = decide(b, e, best);
+  if (d != e) return d;
+  const auto mid = std::partition(order_.begin() + b, order_.begin() + e, [&](uint32_t id) {
+    return map.bin(best.axis, centroids_[id][best.axis]) < best.position;
+  });
+  return uint32_t(mid - order_.begin());
+}
+
+// Full sweep SAH (MacDonald and Booth 1990, as the reference in Wald 2007): on each axis the centroids
+// are sorted and every split between consecutive primitives is evaluated with exact child bounds.
+uint32_t BvhBuilder::split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb) {
+  const uint32_t n = e - b;
+  std::vector<uint32_t> sorted(order_.begin() + b, order_.begin() + e), best_sorted;
+  std::vector<float> right_area(n);
+  SahSplit best;
+  const float area = rb.bounds.area();
+  for (int a = 0; a < 3; ++a) {
+    if (!(rb.centroids.extent()[a] > 0.0f)) continue;  // all centroids on one plane: no split on this axis
+    std::sort(sorted.begin(), sorted.end(), [&](uint32_t x, uint32_t y) {
+      const float cx = centroids_[x][a], cy = centroids_[y][a];
+      return cx != cy ? cx < cy : x < y;
+    });
+    AABB acc;
+    for (uint32_t i = n - 1; i > 0; --i) {
+      acc.extend(bounds_[sorted[i]]);
+      right_area[i] = acc.area();
+    }
+    acc = AABB{};
+    const float before = best.cost;
+    for (uint32_t i = 1; i < n; ++i) {
+      acc.extend(bounds_[sorted[i - 1]]);
+      const float c = config_.costs.split(area, acc.area(), i, right_area[i], n - i);
+      if (c < best.cost) best = {a, int(i), c};
+    }
+    if (best.cost < before) best_sorted = sorted;
+  }
+  const uint32_t d = decide(b, e, best);
+  if (d != e) return d;
+  std::copy(best_sorted.begin(), best_sorted.end(), order_.begin() + b);
+  return b + uint32_t(best.position);
+}
+
+/// Compacts the gapped slots into a depth-first array (left child next, right child patched when it is
+/// reached) and gathers the statistics.
+BvhBuildResult BvhBuilder::flatten() const {
+  BvhBuildResult out;
+  out.order = order_;
+  out.stats.primitives = order_.size();
+  if (slots_.empty()) return out;
+  struct Item {
+    uint32_t slot, parent;
+    uint32_t depth;
+  };
+  std::vector<Item> stack{{0, kInvalidId, 0}};
+  SahCostAccumulator sah(slots_[0].box().area());
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const uint32_t index = uint32_t(out.nodes.size());
+    if (it.parent != kInvalidId) out.nodes[it.parent].offset = index;
+    const BvhNode& node = slots_[it.slot];
+    out.nodes.push_back(node);
+    if (node.is_leaf()) {
+      out.stats.add_leaf(node.count, it.depth);
+      sah.add_leaf(node.box().area(), node.count);
+    } else {
+      sah.add_interior(node.box().area());
+      stack.push_back({node.offset, index, it.depth + 1});
+      stack.push_back({it.slot + 1, kInvalidId, it.depth + 1});
+    }
+  }
+  out.stats.nodes = out.nodes.size();
+  out.stats.sah_cost = sah.cost();
+  return out;
+}
+
+}  // namespace
+
+BvhBuildResult build_bvh(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds,
+                         std::span<const vec3> centroids) {
+  return BvhBuilder(method, config, bounds, centroids).run();
+}
+
+const char* bvh_method_name(BvhMethod method) {
+  switch (method) {
+    case BvhMethod::kMedian:
+      return "bvh-median";
+    case BvhMethod::kBinnedSah:
+      return "bvh-sah";
+    case BvhMethod::kSweepSah:
+      return "bvh-sweep";
+  }
+  return "bvh";
+}
+
+BvhConfig read_bvh_config(BvhMethod method, Params& params) {
+  BvhConfig c;
+  if (method == BvhMethod::kMedian) {
+    c.max_leaf_size = int(params.get_int("leaf_size", 4, 1, 1 << 20));
+  } else {
+    c.max_leaf_size = int(params.get_int("max_leaf_size", 8, 1, 1 << 20));
+    if (method == BvhMethod::kBinnedSah) c.bins = int(params.get_int("bins", 16, 2, 256));
+    c.costs.traversal = float(params.get_float("traversal_cost", 1.0, 0.0, 1e6));
+    c.costs.intersection = float(params.get_float("intersection_cost", 1.0, 1e-6, 1e6));
+  }
+  c.max_depth = int(params.get_int("max_depth", 64, 1, kBvhMaxDepth));
+  return c;
+}
+
+namespace {
+const Registrar kRegisterMedian{structure_info<BvhMedian>(
+    "bvh-median", "binary BVH, object median of centroids on the longest axis", 60)};
+const Registrar kRegisterSah{
+    structure_info<BvhSah>("bvh-sah", "binary BVH, binned SAH (Wald 2007), parallel build", 61)};
+const Registrar kRegisterSweep{
+    structure_info<BvhSweep>("bvh-sweep", "binary BVH, full sweep SAH on all axes (quality reference)", 62)};
+}  // namespace
+
+}  // namespace ab

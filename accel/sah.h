@@ -1,0 +1,119 @@
+// The surface area heuristic (Goldsmith and Salmon 1987; MacDonald and Booth 1990) and the binning
+// of centroids that the binned BVH builder uses (Wald 2007, "On fast construction of SAH-based bounding
+// volume hierarchies"). Written once so that every SAH builder (BVHs, k-d trees) shares the constants.
+#pragma once
+
+#include "accel/geometry.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace ab {
+
+/// Traversal and intersection costs of the SAH. The normalized cost reported in BuildStats uses 1 and 1.
+struct SahCosts {
+  float traversal = 1.0f;     ///< cost of visiting an interior node
+  float intersection = 1.0f;  ///< cost of one primitive test
+
+  /// Cost of a leaf of n primitives (relative to its parent's area ratio, i.e. per unit probability).
+  float leaf(size_t n) const { return intersection * float(n); }
+  /// Cost of splitting a node of area `parent_area` into children (area, count) pairs.
+  float split(float parent_area, float left_area, size_t left_n, float right_area, size_t right_n) const {
+    if (!(parent_area > 0.0f)) return traversal + intersection * float(left_n + right_n);
+    return traversal + intersection * (left_area * float(left_n) + right_area * float(right_n)) / parent_area;
+  }
+};
+
+/// Default costs: traversal 1, intersection 1 (the normalization used in reports).
+inline constexpr SahCosts kUnitSahCosts{};
+
+/// One bin of Wald's binned builder: the bounds of the primitives whose centroid fell in it, and their count.
+struct SahBin {
+  AABB bounds;
+  uint32_t count = 0;
+
+  /// Adds a primitive with bounds b.
+  void add(const AABB& b) {
+    bounds.extend(b);
+    ++count;
+  }
+  /// Merges another bin (exact: min, max and integer sum, so any merge order gives the same bits).
+  void merge(const SahBin& o) {
+    bounds.extend(o.bounds);
+    count += o.count;
+  }
+};
+
+/// Maps a centroid coordinate to one of `bins` bins over [lo, lo + extent] (Wald 2007, eq. for k1).
+struct BinMapping {
+  vec3 lo{0.0f};
+  vec3 scale{0.0f};  ///< bins / extent per axis (0 for a flat axis: everything in bin 0)
+  int bins = 1;
+
+  /// Mapping over centroid bounds cb with `bins` bins per axis.
+  BinMapping(const AABB& cb, int n) : lo(cb.lo), bins(n) {
+    const vec3 e = cb.extent();
+    for (int a = 0; a < 3; ++a) scale[a] = e[a] > 0.0f ? float(n) * (1.0f - 0x1p-12f) / e[a] : 0.0f;
+  }
+  /// Bin of coordinate c along axis a (clamped to [0, bins-1]).
+  int bin(int a, float c) const {
+    const int k = int((c - lo[a]) * scale[a]);
+    return std::clamp(k, 0, bins - 1);
+  }
+};
+
+/// Result of a split search: axis, position (a bin boundary or a sorted index) and SAH cost.
+struct SahSplit {
+  int axis = -1;       ///< -1: no valid split found
+  int position = 0;    ///< bins [0, position) go left (binned), or sorted index split (sweep)
+  float cost = kInf;   ///< SAH cost of the split (with the costs used)
+};
+
+/// Best split among the bin boundaries of one axis: sweeps right to left to get suffix areas, then
+/// left to right evaluating every boundary (Wald 2007). Updates best when a cheaper split is found.
+inline void best_bin_split(const SahBin* bins, int n, int axis, float parent_area, const SahCosts& costs,
+                           SahSplit& best) {
+  std::array<float, 256> right_area{};
+  std::array<uint32_t, 256> right_count{};
+  AABB acc;
+  uint32_t cnt = 0;
+  for (int i = n - 1; i > 0; --i) {
+    acc.extend(bins[i].bounds);
+    cnt += bins[i].count;
+    right_area[i] = acc.area();
+    right_count[i] = cnt;
+  }
+  acc = AABB{};
+  cnt = 0;
+  for (int i = 1; i < n; ++i) {
+    acc.extend(bins[i - 1].bounds);
+    cnt += bins[i - 1].count;
+    if (cnt == 0 || right_count[i] == 0) continue;
+    const float c = costs.split(parent_area, acc.area(), cnt, right_area[i], right_count[i]);
+    if (c < best.cost) best = {axis, i, c};
+  }
+}
+
+/// Normalized SAH cost of a finished tree given per-node areas: sum over interior nodes of
+/// traversal * area + sum over leaves of intersection * count * area, divided by the root area.
+/// Callers accumulate with add_interior/add_leaf and read cost().
+class SahCostAccumulator {
+ public:
+  /// Starts with the root's area and the costs to use (kUnitSahCosts for reports).
+  SahCostAccumulator(float root_area, SahCosts costs = kUnitSahCosts) : root_area_(root_area), costs_(costs) {}
+  /// Adds an interior node of the given area.
+  void add_interior(float area) { sum_ += double(costs_.traversal) * area; }
+  /// Adds a leaf of the given area and primitive count.
+  void add_leaf(float area, size_t n) { sum_ += double(costs_.intersection) * double(n) * area; }
+  /// Normalized cost (0 when the root has no area).
+  double cost() const { return root_area_ > 0.0f ? sum_ / double(root_area_) : 0.0; }
+
+ private:
+  float root_area_;
+  SahCosts costs_;
+  double sum_ = 0.0;
+};
+
+}  // namespace ab
