@@ -70,7 +70,7 @@ inline std::vector<Ray> adversarial_rays(const Mesh& mesh, size_t count, uint32_
     Ray r;
     r.org = {uniform(rng, lo.x, hi.x), uniform(rng, lo.y, hi.y), uniform(rng, lo.z, hi.z)};
     r.dir = {uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)};
-    switch (i % 6) {
+    switch (i % 7) {
       case 1:  // axis-parallel, through a vertex or edge of the mesh
         if (!mesh.vertices.empty()) {
           const vec3 p = mesh.vertices[rng() % mesh.vertices.size()];
@@ -101,6 +101,9 @@ inline std::vector<Ray> adversarial_rays(const Mesh& mesh, size_t count, uint32_
         break;
       case 5:  // aimed at a vertex (ties between the triangles sharing it)
         if (!mesh.vertices.empty()) r.dir = mesh.vertices[rng() % mesh.vertices.size()] - r.org;
+        break;
+      case 6:  // starts exactly at a vertex: every triangle sharing it is hit at t = 0 (ties by id)
+        if (!mesh.vertices.empty()) r.org = mesh.vertices[rng() % mesh.vertices.size()];
         break;
       default:
         break;
