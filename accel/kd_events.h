@@ -8,11 +8,11 @@
 // no plane beats Ci N. The upper levels build in parallel on TBB; the tree is the same for any thread
 // count (every subtree is built deterministically and spliced in a fixed order).
 //
-// One deliberate difference from the paper: the partition itself is conservative (house rule for spatial
-// structures). A primitive whose clipped extent touches the plane or comes within the insertion margin of
-// it goes to both children, so flat geometry lying in a split plane is in both. The sweep's counts follow
-// the paper; a plane chosen to cut off empty space is moved by a few margins into the empty side so that
-// the primitives touching it stay on one side.
+// Robustness without duplicating every primitive that touches a plane: the traversal widens the two
+// halves of the ray interval around t_split (split_plane.h), so a hit on the plane itself (flat geometry
+// lying in it, a vertex or edge touching it) is found on whichever side the primitive was placed; the
+// straddling primitives are clipped into boxes grown by the insertion margin, so clipping rounding never
+// drops a sliver.
 #pragma once
 
 #include "accel/kd_node.h"
@@ -89,16 +89,27 @@ inline float kd_sah_cost(const KdSahSettings& s, float pl, float pr, uint32_t nl
   return lambda * (s.traversal_cost + s.intersection_cost * (pl * float(nl) + pr * float(nr)));
 }
 
+/// Area terms of the children of a node box along one axis, so that each plane costs a few flops.
+struct KdAxisAreas {
+  float lo, hi, cap, side, inv_area;  ///< child area = (cap + side * length) * inv_area
+
+  /// Terms of box along axis a.
+  KdAxisAreas(const AABB& box, int a) : lo(box.lo[a]), hi(box.hi[a]) {
+    const vec3 e = box.extent();
+    const float e1 = e[(a + 1) % 3], e2 = e[(a + 2) % 3];
+    cap = 2.0f * e1 * e2;
+    side = 2.0f * (e1 + e2);
+    inv_area = 1.0f / box.area();
+  }
+};
+
 /// Evaluates plane `pos` on axis a with the paper's counts, both placements of planar primitives.
-inline void evaluate_kd_plane(const KdSahSettings& s, const AABB& box, int a, float pos, uint32_t nl, uint32_t np,
-                              uint32_t nr, KdSahPlane& best) {
-  const vec3 e = box.extent();
-  const float e1 = e[(a + 1) % 3], e2 = e[(a + 2) % 3];
-  const float inv_area = 1.0f / box.area();
-  const float pl = 2.0f * (e1 * e2 + (pos - box.lo[a]) * (e1 + e2)) * inv_area;
-  const float pr = 2.0f * (e1 * e2 + (box.hi[a] - pos) * (e1 + e2)) * inv_area;
+inline void evaluate_kd_plane(const KdSahSettings& s, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
+                              uint32_t np, uint32_t nr, KdSahPlane& best) {
+  const float pl = (ar.cap + ar.side * (pos - ar.lo)) * ar.inv_area;
+  const float pr = (ar.cap + ar.side * (ar.hi - pos)) * ar.inv_area;
   const float cl = kd_sah_cost(s, pl, pr, nl + np, nr);
-  const float cr = kd_sah_cost(s, pl, pr, nl, nr + np);
+  const float cr = np ? kd_sah_cost(s, pl, pr, nl, nr + np) : cl;
   const float c = std::min(cl, cr);
   if (c < best.cost) best = {a, pos, c, cl <= cr, cl <= cr ? nl + np : nl, cl <= cr ? nr : nr + np};
 }
@@ -111,6 +122,7 @@ inline KdSahPlane find_kd_sah_plane(const KdSahSettings& s, const KdEventNode& n
   const uint32_t n = uint32_t(node.ids.size());
   for (int a = 0; a < 3; ++a) {
     const std::vector<KdEvent>& ev = node.events[a];
+    const KdAxisAreas ar(node.box, a);
     uint32_t nl = 0, nr = n;
     for (size_t i = 0; i < ev.size();) {
       const float p = ev[i].pos;
@@ -119,7 +131,7 @@ inline KdSahPlane find_kd_sah_plane(const KdSahSettings& s, const KdEventNode& n
       for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kPlanar; ++i) ++planars;
       for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kStart; ++i) ++starts;
       nr -= planars + ends;
-      if (p > node.box.lo[a] && p < node.box.hi[a]) evaluate_kd_plane(s, node.box, a, p, nl, planars, nr, best);
+      if (p > node.box.lo[a] && p < node.box.hi[a]) evaluate_kd_plane(s, ar, a, p, nl, planars, nr, best);
       nl += starts + planars;
     }
   }
@@ -180,9 +192,9 @@ class KdSahBuilder {
       out.add_leaf(node.ids);
       return;
     }
-    const float split = place_plane(node.box, plane);
+    const float split = plane.pos;
     KdEventNode left, right;
-    partition(std::move(node), plane.axis, split, left, right);
+    partition(std::move(node), plane.axis, split, plane.planar_left, left, right);
     if (left.ids.size() == n && right.ids.size() == n) {
       out.add_leaf(left.ids);
       return;
@@ -203,31 +215,23 @@ class KdSahBuilder {
     }
   }
 
-  /// The plane's coordinate: a plane that cuts off empty space moves a few insertion margins into the
-  /// empty side (when that stays inside the box), so the primitives touching it are not duplicated.
-  static float place_plane(const AABB& box, const KdSahPlane& plane) {
-    const int a = plane.axis;
-    const float shift = 4.0f * insertion_margin(box);
-    float pos = plane.pos;
-    if (plane.n_left == 0 && pos - shift > box.lo[a]) pos -= shift;
-    else if (plane.n_right == 0 && pos + shift < box.hi[a]) pos += shift;
-    return pos;
-  }
-
   /// Splits node's primitives and events at `split` on axis a into left and right (linear time).
-  void partition(KdEventNode&& node, int a, float split, KdEventNode& left, KdEventNode& right) const {
+  void partition(KdEventNode&& node, int a, float split, bool planar_left, KdEventNode& left,
+                 KdEventNode& right) const {
     const size_t n = node.ids.size();
     const float margin = insertion_margin(node.box);
     left.box = node.box;
     right.box = node.box;
     left.box.hi[a] = split;
     right.box.lo[a] = split;
-    // Side of each primitive from its extent on the split axis: bit 0 left, bit 1 right.
-    std::vector<uint8_t> side(n, 0);
+    // Side of each primitive (bit 0 left, bit 1 right), Wald and Havran's classification: ending at or
+    // before the plane is left only, starting at or after it right only, planar in it on the chosen side.
+    std::vector<uint8_t> side(n, 3);
     for (const KdEvent& e : node.events[a]) {
       const uint32_t t = e.local();
-      if (e.type() != KdEvent::kEnd && e.pos <= split + margin) side[t] |= 1;
-      if (e.type() != KdEvent::kStart && e.pos >= split - margin) side[t] |= 2;
+      if (e.type() == KdEvent::kEnd && e.pos <= split) side[t] = 1;
+      else if (e.type() == KdEvent::kStart && e.pos >= split) side[t] = 2;
+      else if (e.type() == KdEvent::kPlanar) side[t] = e.pos < split ? 1 : e.pos > split ? 2 : planar_left ? 1 : 2;
     }
     std::vector<uint32_t> to_left(n), to_right(n);
     for (size_t t = 0; t < n; ++t) {
@@ -241,6 +245,9 @@ class KdSahBuilder {
       }
     }
     for (int k = 0; k < 3; ++k) {
+      const size_t m = node.events[k].size();
+      left.events[k].reserve(m * left.ids.size() / n + 8);
+      right.events[k].reserve(m * right.ids.size() / n + 8);
       split_events(node.events[k], side, to_left, to_right, left.events[k], right.events[k]);
       std::vector<KdEvent>().swap(node.events[k]);
     }
