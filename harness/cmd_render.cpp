@@ -1,5 +1,6 @@
 // `accelbench render --scene F [--accel NAME] [--accel-top NAME] [--accel-bottom NAME] [--spp N]
-//  [--width W] [--height H] [--max-depth D] [--seed S] [--threads T] [--heatmap [--metric nodes|prims]]
+//  [--width W] [--height H] [--max-depth D] [--seed S] [--threads T]
+//  [--heatmap [--metric nodes|prims] [--scale-max V]]
 //  [--param k=v ...] -o FILE.png`
 #include "accel/error.h"
 #include "accel/registry.h"
@@ -31,6 +32,7 @@ struct RenderArgs {
   uint64_t seed = 1;
   bool heatmap = false;
   std::string metric = "nodes";
+  float scale_max = 0.0f;
 };
 
 /// The default structure: the project's SAH BVH where it is registered, else brute force.
@@ -74,7 +76,7 @@ int run_render(const RenderArgs& a) {
     const HeatmapMetric m = a.metric == "prims" ? HeatmapMetric::kPrims : HeatmapMetric::kNodes;
     const std::vector<float> work = render_work(scene, *accel, opt, m);
     out = heatmap_image(work, opt.width, opt.height,
-                        accel->name() + (m == HeatmapMetric::kNodes ? " nodes/ray" : " prims/ray"));
+                        accel->name() + (m == HeatmapMetric::kNodes ? " nodes/ray" : " prims/ray"), a.scale_max);
     counts.camera_rays = uint64_t(opt.width) * uint64_t(opt.height) * uint64_t(opt.spp);
   } else {
     out = to_srgb8(render(scene, *accel, opt, &counts));
@@ -111,6 +113,9 @@ const CommandRegistrar kRender{{"render", "render a scene with the tracer (PNG),
                                   app.add_flag("--heatmap", a->heatmap, "false-colour traversal work per pixel");
                                   app.add_option("--metric", a->metric, "heatmap metric")
                                       ->check(CLI::IsMember({"nodes", "prims"}));
+                                  app.add_option("--scale-max", a->scale_max,
+                                                 "heatmap: value at the top of the colour scale (default: the image's maximum)")
+                                      ->check(CLI::PositiveNumber);
                                   app.add_option("--param", a->params, "accelerator parameter k=v (repeatable)");
                                   app.add_option("-o,--output", a->output, "output .png file")->required();
                                   return [a] { return run_render(*a); };

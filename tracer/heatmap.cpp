@@ -47,13 +47,15 @@ std::string number_label(float v) {
 
 }  // namespace
 
-Image8 heatmap_image(const std::vector<float>& values, int width, int height, const std::string& label) {
+Image8 heatmap_image(const std::vector<float>& values, int width, int height, const std::string& label,
+                     float scale_max) {
   const int scale = width >= 384 ? 2 : 1;
-  const int bar_h = 10 * scale, text_h = 12 * scale, margin = 4 * scale;
+  const int bar_h = 10 * scale, text_h = 24 * scale, margin = 4 * scale;
   Image8 img(width, height + margin + bar_h + text_h + margin);
   std::fill(img.rgb.begin() + std::ptrdiff_t(size_t(width) * size_t(height) * 3), img.rgb.end(), uint8_t(255));
   float vmax = 0.0f;
   for (float v : values) vmax = std::max(vmax, v);
+  if (scale_max > 0.0f) vmax = scale_max;
   const float denom = vmax > 0.0f ? vmax : 1.0f;
   uint8_t c[3];
   for (int y = 0; y < height; ++y)
@@ -71,8 +73,7 @@ Image8 heatmap_image(const std::vector<float>& values, int width, int height, co
   const std::string mid = number_label(vmax / 2.0f), hi = number_label(vmax);
   draw_text(img, (x0 + x1 - text_width(mid, scale)) / 2, ty, mid, scale, 0);
   draw_text(img, x1 - text_width(hi, scale), ty, hi, scale, 0);
-  const int lx = x0 + (x1 - x0) / 4 - text_width(label, scale) / 2;
-  if (text_width(label, scale) < (x1 - x0) / 3) draw_text(img, std::max(x0 + 12 * scale, lx), ty, label, scale, 80);
+  draw_text(img, (x0 + x1 - text_width(label, scale)) / 2, ty + 11 * scale, label, scale, 80);
   return img;
 }
 
