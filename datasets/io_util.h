@@ -1,0 +1,53 @@
+// Small helpers shared by the mesh readers and writers: exact binary reads, little-endian
+// output, and strict number parsing with the file and line in the error.
+#pragma once
+
+#include "accel/error.h"
+
+#include <bit>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <istream>
+#include <string>
+#include <string_view>
+
+namespace ab {
+
+static_assert(std::endian::native == std::endian::little, "binary mesh I/O assumes a little-endian host");
+
+/// Size of a file in bytes.
+inline uint64_t file_size(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path + ": cannot read file size: " + ec.message());
+  return size;
+}
+
+/// Reads exactly n bytes or throws naming the file.
+inline void read_exactly(std::istream& in, char* data, size_t n, const std::string& path) {
+  in.read(data, static_cast<std::streamsize>(n));
+  if (static_cast<size_t>(in.gcount()) != n) throw InputError(path + ": unexpected end of file");
+}
+
+/// Appends a little-endian 32-bit value.
+template <class T>
+inline void put_le32(std::string& buffer, T value) {
+  static_assert(sizeof(T) == 4);
+  uint32_t bits;
+  std::memcpy(&bits, &value, 4);
+  for (int i = 0; i < 4; ++i) buffer.push_back(static_cast<char>((bits >> (8 * i)) & 0xFF));
+}
+
+/// Parses a whole token as a float (from_chars: locale-independent, accepts nan/inf, which the
+/// callers reject separately), or throws naming the file and line.
+inline float parse_float(std::string_view token, const std::string& path, size_t line) {
+  float f = 0.0f;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), f);
+  if (token.empty() || ec != std::errc() || end != token.data() + token.size())
+    throw InputError(path + ":" + std::to_string(line) + ": '" + std::string(token) + "' is not a number");
+  return f;
+}
+
+}  // namespace ab

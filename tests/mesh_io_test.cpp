@@ -1,0 +1,310 @@
+// Mesh I/O: the contract's id rule (file face order, fan triangulation, every face kept) for every
+// format, round trips, the real meshes, and bad files.
+#include "datasets/generators.h"
+#include "datasets/mesh_io.h"
+
+#include "accel/error.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace ab {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A scratch directory removed at the end of the test.
+class MeshIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("accelbench_mesh_io_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& content) const {
+    std::ofstream(path(name), std::ios::binary) << content;
+    return path(name);
+  }
+  fs::path dir_;
+};
+
+// The test polygon soup: a quad, a pentagon, three more faces on edge (0,1) (non-manifold), a
+// duplicated face and a degenerate face (repeated vertex).
+const std::vector<vec3> kVertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0},    {0, 1, 0},
+                                     {2, 0.5f, 0}, {1.5f, 2, 0.1f}, {0.5f, 1, 1}, {0.25f, -1, 0.75f}};
+const std::vector<std::vector<int>> kFaces = {{0, 1, 2, 3}, {0, 1, 4, 5, 6}, {0, 1, 5}, {0, 1, 6},
+                                              {0, 1, 7},    {2, 3, 4},       {2, 3, 4}, {1, 1, 2}};
+const std::vector<glm::uvec3> kTriangles = {{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {0, 4, 5}, {0, 5, 6}, {0, 1, 5},
+                                            {0, 1, 6}, {0, 1, 7}, {2, 3, 4}, {2, 3, 4}, {1, 1, 2}};
+
+std::string obj_text() {
+  std::ostringstream s;
+  s << "# test\n";
+  for (const vec3& v : kVertices) s << "v " << v.x << ' ' << v.y << ' ' << v.z << '\n';
+  for (const auto& f : kFaces) {
+    s << 'f';
+    for (int i : f) s << ' ' << i + 1;
+    s << '\n';
+  }
+  return s.str();
+}
+
+std::string off_text() {
+  std::ostringstream s;
+  s << "OFF\n" << kVertices.size() << ' ' << kFaces.size() << " 0\n";
+  for (const vec3& v : kVertices) s << v.x << ' ' << v.y << ' ' << v.z << '\n';
+  for (const auto& f : kFaces) {
+    s << f.size();
+    for (int i : f) s << ' ' << i;
+    s << '\n';
+  }
+  return s.str();
+}
+
+std::string ply_header(const std::string& format, size_t vertices, size_t faces) {
+  return "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(faces) +
+         "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+std::string ply_ascii_text() {
+  std::ostringstream s;
+  s << ply_header("ascii", kVertices.size(), kFaces.size());
+  for (const vec3& v : kVertices) s << v.x << ' ' << v.y << ' ' << v.z << '\n';
+  for (const auto& f : kFaces) {
+    s << f.size();
+    for (int i : f) s << ' ' << i;
+    s << '\n';
+  }
+  return s.str();
+}
+
+/// Appends 4 bytes of value in little or big endian order.
+template <class T>
+void put4(std::string& s, T value, bool big) {
+  unsigned char b[4];
+  std::memcpy(b, &value, 4);
+  for (int i = 0; i < 4; ++i) s.push_back(static_cast<char>(b[big ? 3 - i : i]));
+}
+
+std::string ply_binary_text(bool big) {
+  std::string s = ply_header(big ? "binary_big_endian" : "binary_little_endian", kVertices.size(), kFaces.size());
+  for (const vec3& v : kVertices) {
+    put4(s, v.x, big);
+    put4(s, v.y, big);
+    put4(s, v.z, big);
+  }
+  for (const auto& f : kFaces) {
+    s.push_back(static_cast<char>(f.size()));
+    for (int i : f) put4(s, i, big);
+  }
+  return s;
+}
+
+std::string stl_ascii_text() {
+  std::ostringstream s;
+  s << "solid test\n";
+  for (const glm::uvec3& t : kTriangles) {
+    s << "  facet normal 0 0 1\n    outer loop\n";
+    for (uint32_t i : {t.x, t.y, t.z}) s << "      vertex " << kVertices[i].x << ' ' << kVertices[i].y << ' ' << kVertices[i].z << '\n';
+    s << "    endloop\n  endfacet\n";
+  }
+  s << "endsolid test\n";
+  return s.str();
+}
+
+std::string stl_binary_text() {
+  std::string s(80, ' ');
+  put4(s, static_cast<uint32_t>(kTriangles.size()), false);
+  for (const glm::uvec3& t : kTriangles) {
+    for (int k = 0; k < 3; ++k) put4(s, 0.0f, false);
+    for (uint32_t i : {t.x, t.y, t.z})
+      for (int k = 0; k < 3; ++k) put4(s, kVertices[i][k], false);
+    s += std::string(2, '\0');
+  }
+  return s;
+}
+
+/// Same indices and vertices as the test soup.
+void expect_indexed(const Mesh& m) {
+  ASSERT_EQ(m.vertices.size(), kVertices.size());
+  for (size_t i = 0; i < kVertices.size(); ++i) EXPECT_EQ(m.vertices[i], kVertices[i]) << "vertex " << i;
+  ASSERT_EQ(m.triangles.size(), kTriangles.size());
+  for (size_t i = 0; i < kTriangles.size(); ++i) EXPECT_EQ(m.triangles[i], kTriangles[i]) << "triangle " << i;
+}
+
+/// Same triangle corners, in order (for STL, which has no shared vertices).
+void expect_corners(const Mesh& m, const Mesh& expected) {
+  ASSERT_EQ(m.size(), expected.size());
+  for (size_t i = 0; i < m.size(); ++i) {
+    const Triangle a = m.triangle(i), b = expected.triangle(i);
+    EXPECT_TRUE(a.v0 == b.v0 && a.v1 == b.v1 && a.v2 == b.v2) << "triangle " << i;
+  }
+}
+
+Mesh soup_mesh() {
+  Mesh m;
+  m.vertices = kVertices;
+  m.triangles = kTriangles;
+  return m;
+}
+
+TEST_F(MeshIoTest, ObjKeepsFaceOrderFansAndEveryFace) { expect_indexed(read_mesh(write("a.obj", obj_text()))); }
+TEST_F(MeshIoTest, ObjCornerFormsNegativeIndicesAndRepeatedCorners) {
+  // i/t/n and i//n corners, negative (relative) indices, and a quad with a repeated corner, which
+  // must still give two triangles in fan order (OpenMesh's OBJ reader would merge the corners).
+  const Mesh m = read_mesh(write("c.obj",
+                                 "o thing\nv 0 0 0\nv 1 0 0\nvt 0 0\nvn 0 0 1\nv 1 1 0 # comment\nv 0 1 0\n"
+                                 "usemtl x\nf 1/1/1 2/1/1 3/1/1\nf 1//1 3//1 4//1\nf -4 -3 -2 -1\nf 1 2 2 3\n"
+                                 "s off\nl 1 2\n"));
+  const std::vector<glm::uvec3> expected = {{0, 1, 2}, {0, 2, 3}, {0, 1, 2}, {0, 2, 3}, {0, 1, 1}, {0, 1, 2}};
+  EXPECT_EQ(m.triangles, expected);
+  EXPECT_EQ(m.vertices.size(), 4u);
+}
+TEST_F(MeshIoTest, OffKeepsFaceOrderFansAndEveryFace) { expect_indexed(read_mesh(write("a.off", off_text()))); }
+TEST_F(MeshIoTest, AsciiPlyKeepsFaceOrderFansAndEveryFace) {
+  expect_indexed(read_mesh(write("a.ply", ply_ascii_text())));
+}
+TEST_F(MeshIoTest, BinaryPlyKeepsFaceOrderFansAndEveryFace) {
+  expect_indexed(read_mesh(write("le.ply", ply_binary_text(false))));
+  expect_indexed(read_mesh(write("be.ply", ply_binary_text(true))));
+}
+TEST_F(MeshIoTest, StlKeepsEveryTriangleInOrder) {
+  expect_corners(read_mesh(write("a.stl", stl_ascii_text())), soup_mesh());
+  expect_corners(read_mesh(write("b.stl", stl_binary_text())), soup_mesh());
+}
+TEST_F(MeshIoTest, BinaryStlWhoseHeaderStartsWithSolid) {
+  std::string s = stl_binary_text();
+  s.replace(0, 5, "solid");
+  expect_corners(read_mesh(write("c.stl", s)), soup_mesh());
+}
+
+TEST_F(MeshIoTest, RoundTripEveryFormatExactly) {
+  Params p;
+  const Mesh m = generate_mesh("cityscape", 700, 5, p);  // includes duplicate and zero-area triangles
+  const Mesh s = generate_mesh("soup", 300, 9, p);       // arbitrary float coordinates
+  for (const Mesh* mesh : {&m, &s})
+    for (const char* ext : {"obj", "off", "ply", "stl"}) {
+      SCOPED_TRACE(ext);
+      const std::string file = path(std::string("r.") + ext);
+      write_mesh(*mesh, file);
+      const Mesh back = read_mesh(file);
+      if (std::string(ext) == "stl") {
+        expect_corners(back, *mesh);
+      } else {
+        EXPECT_EQ(back.vertices, mesh->vertices);
+        EXPECT_EQ(back.triangles, mesh->triangles);
+      }
+    }
+}
+
+TEST_F(MeshIoTest, WritingIsByteDeterministicAndLeavesNoTemporaryFile) {
+  Params p;
+  const Mesh m = generate_mesh("sphereflake", 500, 1, p);
+  for (const char* ext : {"obj", "off", "ply", "stl"}) {
+    const std::string a = path(std::string("a.") + ext), b = path(std::string("b.") + ext);
+    write_mesh(m, a);
+    write_mesh(m, b);
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    const std::string ca((std::istreambuf_iterator<char>(fa)), {}), cb((std::istreambuf_iterator<char>(fb)), {});
+    EXPECT_FALSE(ca.empty());
+    EXPECT_EQ(ca, cb) << ext;
+  }
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) files += e.is_regular_file();
+  EXPECT_EQ(files, 8u);
+}
+
+TEST_F(MeshIoTest, EmptyMeshRoundTrips) {
+  for (const char* ext : {"obj", "off", "ply", "stl"}) {
+    const std::string file = path(std::string("e.") + ext);
+    write_mesh(Mesh{}, file);
+    EXPECT_EQ(read_mesh(file).size(), 0u) << ext;
+  }
+}
+
+/// Expects InputError whose message names the file and contains `what`.
+void expect_input_error(const std::string& file, const std::string& what) {
+  try {
+    read_mesh(file);
+    ADD_FAILURE() << "no error for " << file;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(file), std::string::npos) << msg;
+    EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+TEST_F(MeshIoTest, MissingFileAndUnknownExtension) {
+  expect_input_error(path("missing.obj"), "no such file");
+  expect_input_error(write("a.xyz", obj_text()), "unknown mesh format");
+  expect_input_error(write("noext", obj_text()), "unknown mesh format");
+  EXPECT_THROW(write_mesh(soup_mesh(), path("a.xyz")), InputError);
+  EXPECT_FALSE(fs::exists(path("a.xyz.tmp")));
+}
+
+TEST_F(MeshIoTest, NonFiniteCoordinates) {
+  expect_input_error(write("nan.obj", "v 0 0 0\nv nan 1 0\nv 0 1 0\nf 1 2 3\n"), "NaN or infinite");
+  expect_input_error(write("inf.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"), "NaN or infinite");
+  std::string ply = ply_binary_text(false);
+  const size_t at = ply.find("end_header\n") + 11 + 4;  // y of vertex 0
+  const float nan = std::nanf("");
+  std::memcpy(&ply[at], &nan, 4);
+  expect_input_error(write("nan.ply", ply), "NaN or infinite");
+  expect_input_error(write("nan.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n"
+                                      "vertex 0 1 0\nendloop\nendfacet\nendsolid x\n"),
+                     "NaN or infinite");
+}
+
+TEST_F(MeshIoTest, IndexOutOfRange) {
+  expect_input_error(write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n"), "vertex");
+  expect_input_error(write("bad.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 7\n"), "vertex");
+  expect_input_error(write("bad.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "vertex");
+}
+
+TEST_F(MeshIoTest, TruncatedBinaryFiles) {
+  const std::string ply = ply_binary_text(false);
+  expect_input_error(write("t.ply", ply.substr(0, ply.size() - 7)), "end of file");
+  const std::string stl = stl_binary_text();
+  expect_input_error(write("t.stl", stl.substr(0, stl.size() - 20)), "truncated");
+  expect_input_error(write("u.stl", stl.substr(0, 50)), "truncated");
+  const std::string ascii = stl_ascii_text();
+  expect_input_error(write("t2.stl", ascii.substr(0, ascii.size() / 2)), "truncated");
+}
+
+TEST_F(MeshIoTest, MalformedContent) {
+  expect_input_error(write("m.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"), "truncated");
+  expect_input_error(write("m.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n"), "not a number");
+  expect_input_error(write("m.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"), "end_header");
+  expect_input_error(write("n.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n"),
+                     "x, y or z");
+  expect_input_error(write("m.obj", "v 0 0\n"), "three coordinates");
+  expect_input_error(write("n.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n"), "fewer than three");
+  expect_input_error(write("o.obj", "v 0 0 0\nv 1 0 0\nv 1 1 1\nf 1 x 3\n"), "not a vertex index");
+  expect_input_error(write("n.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"), "");
+}
+
+/// Triangle count of a real mesh in ../shared/meshes, or skips when it is absent.
+void expect_real_mesh(const std::string& name, size_t faces) {
+  const std::string file = std::string(ACCELBENCH_SOURCE_DIR "/../shared/meshes/") + name;
+  if (!fs::exists(file)) GTEST_SKIP() << file << " is absent; the real-mesh test needs it";
+  const Mesh m = read_mesh(file);
+  EXPECT_EQ(m.size(), faces);
+  EXPECT_FALSE(m.bounds().empty());
+}
+
+TEST(MeshIoRealMeshes, StanfordBunny) { expect_real_mesh("stanford-bunny.obj", 69451); }
+TEST(MeshIoRealMeshes, Teapot) { expect_real_mesh("teapot.obj", 6320); }
+
+}  // namespace
+}  // namespace ab
