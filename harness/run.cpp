@@ -300,8 +300,8 @@ std::unique_ptr<Accelerator> Runner::build(const Target& target, const std::stri
     accel->build();
     return accel->stats().build_seconds;
   };
-  const Timing t =
-      timer_.time("build/" + scene + "/" + spec.label, suite_.repetitions, 1, pass, double(target.triangles));
+  const Timing t = timer_.time("build/" + scene + "/" + spec.label, suite_.build_repetitions, 1, pass,
+                               double(target.triangles));
   const BuildStats& s = accel->stats();
   const double tri = target.triangles ? double(target.triangles) : 1.0;
   base = {{"scene", scene},

@@ -259,6 +259,9 @@ void parse_settings(const json& j, const Where& w, Suite& suite) {
   if (j.contains("seed")) suite.seed = read_count(j["seed"], w.at("seed"), 0, UINT64_MAX);
   if (j.contains("repetitions"))
     suite.repetitions = int(read_count(j["repetitions"], w.at("repetitions"), 1, 1000));
+  suite.build_repetitions = suite.repetitions;
+  if (j.contains("build_repetitions"))
+    suite.build_repetitions = int(read_count(j["build_repetitions"], w.at("build_repetitions"), 1, 1000));
   if (j.contains("warmup")) suite.warmup = int(read_count(j["warmup"], w.at("warmup"), 0, 1000));
   if (j.contains("min_time")) {
     if (!j["min_time"].is_number() || j["min_time"].get<double>() < 0 || j["min_time"].get<double>() > 60)
@@ -278,8 +281,8 @@ void parse_settings(const json& j, const Where& w, Suite& suite) {
 Suite parse_suite(const nlohmann::json& j, const std::string& source, const std::string& base_dir) {
   const Where root{source, ""};
   check_keys(j, root,
-             {"name", "description", "seed", "repetitions", "warmup", "min_time", "threads", "build_only",
-              "scenes", "accelerators", "rays", "verify"});
+             {"name", "description", "seed", "repetitions", "build_repetitions", "warmup", "min_time",
+              "threads", "build_only", "scenes", "accelerators", "rays", "verify"});
   Suite suite;
   suite.source = source;
   suite.json = j;
@@ -321,7 +324,8 @@ constexpr const char* kDefaultSuiteJson = R"json({
   "name": "default",
   "description": "Every registered accelerator on four generators at two sizes, four ray kinds, 1 thread and all cores; about 10 minutes on 2 cores.",
   "seed": 1,
-  "repetitions": 3,
+  "repetitions": 5,
+  "build_repetitions": 3,
   "warmup": 1,
   "min_time": 0.01,
   "threads": [1, 0],
@@ -333,10 +337,10 @@ constexpr const char* kDefaultSuiteJson = R"json({
   ],
   "accelerators": ["all"],
   "rays": [
-    {"kind": "primary", "count": 32768},
-    {"kind": "shadow", "count": 32768},
-    {"kind": "diffuse", "count": 32768},
-    {"kind": "incoherent", "count": 32768}
+    {"kind": "primary", "count": 65536},
+    {"kind": "shadow", "count": 65536},
+    {"kind": "diffuse", "count": 65536},
+    {"kind": "incoherent", "count": 65536}
   ],
   "verify": {"brute_rays": 1000, "reference": "bvh-sah", "embree": true}
 }

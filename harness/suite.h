@@ -58,6 +58,7 @@ struct Suite {
   std::vector<RaySpec> rays;
   std::vector<int> threads{1, 0};  ///< 0 = all hardware threads
   int repetitions = 3;             ///< timed repetitions (median, min and max over them)
+  int build_repetitions = 3;       ///< builds per scene x configuration (default: repetitions)
   int warmup = 1;                  ///< untimed passes before timing
   double min_time = 0.02;   ///< seconds each timed repetition lasts at least (more iterations if faster)
   uint64_t seed = 1;        ///< seed of the ray sets
