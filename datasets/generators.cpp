@@ -276,11 +276,12 @@ Mesh make_slivers(uint64_t triangles, uint64_t seed, Params& params) {
 // ---------------------------------------------------------------------------------------------
 // Stadium
 
-/// Adds an inward-facing box (12 triangles) from lo to hi.
-void add_room(MeshBuilder& out, const vec3& lo, const vec3& hi) {
+/// Adds an open-air stadium (10 triangles): a floor from lo to hi (y = lo.y) and four walls of
+/// height hi.y - lo.y, open at the top so that a camera above it sees the floor and what stands on it.
+void add_stadium_bowl(MeshBuilder& out, const vec3& lo, const vec3& hi) {
   uint32_t v[8];
   for (int i = 0; i < 8; ++i) v[i] = out.vertex({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-  const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  const int faces[5][4] = {{0, 1, 5, 4}, {0, 4, 6, 2}, {1, 3, 7, 5}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& f : faces) {
     out.triangle(v[f[0]], v[f[1]], v[f[2]]);
     out.triangle(v[f[0]], v[f[2]], v[f[3]]);
@@ -292,7 +293,7 @@ Mesh make_stadium(uint64_t triangles, uint64_t /*seed*/, Params& params) {
   const int depth = static_cast<int>(params.get_int("depth", -1, -1, 7));
   MeshBuilder out(triangles + 64, triangles / 2 + 64);
   const float half = 0.5f * scale;
-  add_room(out, vec3(-half, 0.0f, -half), vec3(half, 0.5f * scale, half));
+  add_stadium_bowl(out, vec3(-half, 0.0f, -half), vec3(half, 0.05f * scale, half));
   if (triangles > out.triangles()) add_sphereflake(out, triangles - out.triangles(), depth, vec3(0, 1, 0), 1.0f);
   return out.finish(triangles);
 }
@@ -356,7 +357,7 @@ const std::vector<GeneratorInfo>& generators() {
       {"terrain", "fractal heightfield, fBm noise over a grid, SPD mount (params roughness, height)", make_terrain},
       {"tetra", "SPD tetra: recursive Sierpinski tetrahedra (params depth)", make_tetra},
       {"soup", "uniformly random small triangles in the unit cube (params size)", make_soup},
-      {"stadium", "teapot in a stadium: a dense sphereflake inside a huge empty room (params scale, depth)",
+      {"stadium", "teapot in a stadium: a dense sphereflake in the middle of a huge open-air stadium (params scale, depth)",
        make_stadium},
       {"slivers", "long thin triangles at random angles (params length, aspect)", make_slivers},
       {"cityscape",

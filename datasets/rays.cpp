@@ -31,8 +31,8 @@ Frame frame_of(const AABB& bounds) {
   return f;
 }
 
-/// A pinhole camera looking at the box centre from a fixed direction, far enough back that the
-/// box's bounding sphere fits the 45 degree field of view, with a width x height pixel grid.
+/// A pinhole camera looking at the box centre from a fixed direction, just far enough back that
+/// all eight box corners fit the 45 degree field of view, with a width x height pixel grid.
 struct Camera {
   vec3 eye, forward, right, up;
   float tan_half;
@@ -40,11 +40,21 @@ struct Camera {
 
   Camera(const Frame& f, uint64_t count) {
     forward = glm::normalize(vec3(-0.55f, -0.45f, -0.7f));
-    const float half_fov = 22.5f * kPi / 180.0f;
-    tan_half = std::tan(half_fov);
-    eye = f.center - forward * (0.5f * f.diag / std::sin(half_fov) * 1.02f);
+    tan_half = std::tan(22.5f * kPi / 180.0f);
     right = glm::normalize(glm::cross(forward, vec3(0.0f, 1.0f, 0.0f)));
     up = glm::cross(right, forward);
+    // Distance d such that every corner c satisfies |x|, |y| <= tan_half * (d + z) in camera space.
+    float distance = 0.0f;
+    for (int i = 0; i < 8; ++i) {
+      const vec3 c((i & 1) ? f.box.hi.x : f.box.lo.x, (i & 2) ? f.box.hi.y : f.box.lo.y,
+                   (i & 4) ? f.box.hi.z : f.box.lo.z);
+      const vec3 r = c - f.center;
+      const float z = glm::dot(r, forward);
+      const float reach = std::max(std::fabs(glm::dot(r, right)), std::fabs(glm::dot(r, up)));
+      distance = std::max(distance, reach / tan_half - z);
+    }
+    distance = std::max(distance * 1.02f, 1e-3f * f.diag);
+    eye = f.center - forward * distance;
     width = std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(std::sqrt(static_cast<double>(count)))));
     height = std::max<uint64_t>(1, (count + width - 1) / width);
   }
