@@ -1,0 +1,10 @@
+#include "accel/bsp.h"
+
+#include "accel/registry.h"
+
+namespace ab {
+namespace {
+const Registrar kRegisterBsp{structure_info<BspTree>(
+    "bsp", "BSP tree, arbitrary planes (13 directions + triangles' own planes), SAH over the cell", 35)};
+}  // namespace
+}  // namespace ab
