@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "accel/error.h"
 #include "harness/cli.h"
 #include "harness/report.h"
 #include "harness/run.h"
@@ -70,6 +71,10 @@ int run_command(const RunArgs& a) {
   options.color = stderr_is_terminal();
   options.interrupted = &g_interrupted;
   g_interrupted.store(false);
+  std::error_code ec;
+  std::filesystem::create_directories(options.out_dir, ec);
+  if (ec || !std::filesystem::is_directory(options.out_dir))
+    throw InputError(options.out_dir + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
   auto previous = std::signal(SIGINT, on_sigint);
   const nlohmann::json report = run_suite(suite, options);
   std::signal(SIGINT, previous);

@@ -9,6 +9,7 @@
 #include <CLI/Version.hpp>
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <glm/glm.hpp>
 #include <pugixml.hpp>
@@ -88,6 +89,37 @@ std::string compiled_isa() {
   return s.empty() ? "baseline" : s.substr(1);
 }
 
+/// The flags the core library was compiled with, read from compile_commands.json in the build folder
+/// (the executable's folder; CMAKE_EXPORT_COMPILE_COMMANDS is on): every argument but the compiler,
+/// -o/-c and their files, -I and -D (but -DNDEBUG).
+std::string build_flags() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return "";
+  std::ifstream in(exe.parent_path() / "compile_commands.json");
+  if (!in) return "";
+  try {
+    const nlohmann::json db = nlohmann::json::parse(in);
+    for (const auto& entry : db) {
+      if (entry.value("file", "").find("accel/trace.cpp") == std::string::npos) continue;
+      std::istringstream args(entry.value("command", ""));
+      std::string arg, flags;
+      args >> arg;  // the compiler
+      while (args >> arg) {
+        if (arg == "-o" || arg == "-c") {
+          args >> arg;
+          continue;
+        }
+        if (arg.rfind("-I", 0) == 0 || (arg.rfind("-D", 0) == 0 && arg != "-DNDEBUG")) continue;
+        flags += (flags.empty() ? "" : " ") + arg;
+      }
+      return flags;
+    }
+  } catch (const nlohmann::json::exception&) {
+  }
+  return "";
+}
+
 }  // namespace
 
 nlohmann::json machine_info() {
@@ -123,12 +155,8 @@ nlohmann::json compiler_info() {
 #else
   const bool optimized = false;
 #endif
-#ifdef ACCELBENCH_CXX_FLAGS
-  const std::string flags = ACCELBENCH_CXX_FLAGS;
-#else
-  const std::string flags =
-      "-O3 -march=native -DNDEBUG -Wall -Wextra -ffp-contract=off (CMakeLists.txt Release)";
-#endif
+  std::string flags = build_flags();
+  if (flags.empty()) flags = "unknown (no compile_commands.json beside the executable)";
   return {{"compiler", compiler},
           {"version", __VERSION__},
           {"cxx_standard", long(__cplusplus)},
