@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -164,6 +165,29 @@ std::map<std::string, ConfigSummary> summarize(const nlohmann::json& report,
   return by_config;
 }
 
+void print_verification_line(std::ostream& out, const nlohmann::json& report) {
+  const auto& v = report.value("verification", nlohmann::json::object());
+  uint64_t checks = 0;
+  for (const auto& b : report.value("builds", nlohmann::json::array()))
+    checks += b.value("verification", nlohmann::json::array()).size();
+  const uint64_t brute_rays = v.value("brute_rays", 0);
+  out << "verification: " << checks << " configuration x ray set checks against brute force ("
+      << (brute_rays ? "first " + std::to_string(brute_rays) + " rays of each set" : std::string("all rays"))
+      << "), " << v.value("reference", "") << " (all rays) and Embree; "
+      << report.value("failures", nlohmann::json::array()).size() << " failures\n";
+}
+
+void print_correlation_line(std::ostream& out, const nlohmann::json& report) {
+  std::vector<double> r;
+  for (const auto& g : report.value("sah_correlation", nlohmann::json::array()))
+    if (g["pearson"].is_number()) r.push_back(g["pearson"].get<double>());
+  if (r.empty()) return;
+  std::sort(r.begin(), r.end());
+  out << "SAH cost vs measured cost per ray (Pearson r over configurations): median "
+      << fmt(r[r.size() / 2], 2) << ", min " << fmt(r.front(), 2) << ", max " << fmt(r.back(), 2) << " over "
+      << r.size() << " scene x ray set groups\n";
+}
+
 }  // namespace
 
 void print_summary_table(std::ostream& out, const nlohmann::json& report, bool color) {
@@ -189,6 +213,8 @@ void print_summary_table(std::ostream& out, const nlohmann::json& report, bool c
         << fmt(s.nodes.value(), 1) << std::setw(10) << fmt(s.prims.value(), 1) << "  "
         << (s.verified ? green : red) << (s.verified ? "ok" : "FAILED") << reset << "\n";
   }
+  print_verification_line(out, report);
+  print_correlation_line(out, report);
 }
 
 bool stderr_is_terminal() {

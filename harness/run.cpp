@@ -498,6 +498,10 @@ void Runner::fill_ratios() {
   }
 }
 
+// Havran 2000 ("Heuristic Ray Shooting Algorithms", PhD thesis, ch. 2) judges structures by
+// hardware-independent counts: traversal steps and intersection tests per ray, combined with the same
+// costs the surface area heuristic (Goldsmith and Salmon 1987; MacDonald and Booth 1990) predicts with.
+// The correlation is Pearson's product-moment coefficient.
 /// Pearson's r between the SAH-predicted cost of each configuration and its measured Havran cost
 /// (traversal steps + intersection tests per ray, costs 1 and 1 like sah_cost), per scene and ray set.
 void Runner::fill_correlations() {

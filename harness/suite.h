@@ -11,6 +11,7 @@ namespace ab {
 
 /// One scene of a suite: a generated mesh, a mesh file or a scene file.
 struct SceneSpec {
+  /// Where the geometry comes from.
   enum class Source { kGenerator, kMesh, kScene };
   Source source = Source::kGenerator;
   std::string label;                          ///< unique name in reports (for example "sphere-10000")
