@@ -1,0 +1,237 @@
+// k-d trees (kdtree-median, kdtree-sah): node encoding, the plane step, flat geometry lying in split
+// planes, rays lying in split planes, statistics, thread-count independence and parameter checks.
+#include "accel/kd_node.h"
+#include "accel/kdtree.h"
+#include "accel/split_plane.h"
+#include "structure_test_helpers.h"
+
+#include <tbb/global_control.h>
+
+#include <gtest/gtest.h>
+
+namespace ab {
+namespace {
+
+using testing::adversarial_mesh;
+using testing::adversarial_rays;
+using testing::count_differences;
+using testing::random_soup;
+using testing::uniform;
+
+const char* const kKdNames[] = {"kdtree-median", "kdtree-sah"};
+
+/// k x k quads on each of the planes x = i / k, y = i / k and z = i / k (i = 0..k): flat geometry on the
+/// coordinates where median and SAH planes fall.
+Mesh axis_planes(int k) {
+  Mesh m;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int i = 0; i <= k; i += 2) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+          const uint32_t base = uint32_t(m.vertices.size());
+          for (int c = 0; c < 4; ++c) {
+            vec3 p(0.0f);
+            p[axis] = float(i) / float(k);
+            p[u] = float(a + (c == 1 || c == 2)) / float(k);
+            p[v] = float(b + (c >= 2)) / float(k);
+            m.vertices.push_back(p);
+          }
+          m.triangles.push_back({base, base + 1, base + 2});
+          m.triangles.push_back({base, base + 2, base + 3});
+        }
+    }
+  return m;
+}
+
+/// Rays lying in the planes x, y or z = i / k (a zero direction component on that axis), starting
+/// outside or on the geometry, plus rays along the lines where two planes meet.
+std::vector<Ray> in_plane_rays(int k, size_t count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::vector<Ray> rays;
+  for (size_t n = 0; n < count; ++n) {
+    Ray r;
+    const int axis = int(n % 3);
+    r.org = {uniform(rng, -0.5f, 1.5f), uniform(rng, -0.5f, 1.5f), uniform(rng, -0.5f, 1.5f)};
+    r.org[axis] = float(rng() % (k + 1)) / float(k);
+    r.dir = {uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)};
+    r.dir[axis] = (n % 5 == 4) ? -0.0f : 0.0f;
+    if (n % 4 == 3) {  // along an edge line: two coordinates on planes, one direction component
+      const int b = (axis + 1) % 3;
+      r.org[b] = float(rng() % (k + 1)) / float(k);
+      r.dir[b] = 0.0f;
+    }
+    rays.push_back(r);
+  }
+  return rays;
+}
+
+TEST(KdNode, EncodesLeavesAndInteriorNodes) {
+  const KdNode leaf = KdNode::leaf(123, 45);
+  EXPECT_TRUE(leaf.is_leaf());
+  EXPECT_EQ(leaf.first(), 123u);
+  EXPECT_EQ(leaf.count(), 45u);
+  KdNode inner = KdNode::interior(2, -1.25f, 77);
+  EXPECT_FALSE(inner.is_leaf());
+  EXPECT_EQ(inner.axis(), 2);
+  EXPECT_EQ(inner.split(), -1.25f);
+  EXPECT_EQ(inner.above(), 77u);
+  inner.rebase(10, 1000);
+  EXPECT_EQ(inner.above(), 87u);
+  EXPECT_EQ(inner.split(), -1.25f);
+  KdNode moved = leaf;
+  moved.rebase(10, 1000);
+  EXPECT_EQ(moved.first(), 1123u);
+  EXPECT_EQ(moved.count(), 45u);
+}
+
+TEST(SplitPlane, ParallelRaysStayOnTheirSideAndInPlaneRaysSeeBoth) {
+  const PlaneVisit below = split_at_axis_plane(0.0f, 0.0f, kInf, 1.0f, 0.0f, 10.0f);
+  EXPECT_TRUE(below.first_below);
+  EXPECT_TRUE(below.visit_first);
+  EXPECT_FALSE(below.visit_second);
+  const PlaneVisit above = split_at_axis_plane(2.0f, -0.0f, -kInf, 1.0f, 0.0f, 10.0f);
+  EXPECT_FALSE(above.first_below);
+  EXPECT_TRUE(above.visit_first);
+  EXPECT_FALSE(above.visit_second);
+  const PlaneVisit in = split_at_axis_plane(1.0f, 0.0f, kInf, 1.0f, 0.0f, 10.0f);
+  EXPECT_TRUE(in.visit_first && in.visit_second);
+  EXPECT_EQ(in.first_t1, 10.0f);
+  EXPECT_EQ(in.second_t0, 0.0f);
+}
+
+TEST(SplitPlane, CrossingRaysGetWidenedHalves) {
+  // Origin below, moving up: below first, crossing at t = 2.
+  const PlaneVisit up = split_at_axis_plane(0.0f, 0.5f, 2.0f, 1.0f, 0.0f, 10.0f);
+  EXPECT_TRUE(up.first_below);
+  EXPECT_TRUE(up.visit_first && up.visit_second);
+  EXPECT_GT(up.first_t1, 2.0f);
+  EXPECT_LT(up.second_t0, 2.0f);
+  // Moving down from below: the plane is behind (t = -2); only the below side is ahead.
+  const PlaneVisit down = split_at_axis_plane(0.0f, -0.5f, -2.0f, 1.0f, 0.0f, 10.0f);
+  EXPECT_FALSE(down.first_below);
+  EXPECT_FALSE(down.visit_first);
+  EXPECT_TRUE(down.visit_second);
+  // Interval entirely before the crossing.
+  const PlaneVisit early = split_at_axis_plane(0.0f, 0.5f, 2.0f, 1.0f, 0.0f, 1.0f);
+  EXPECT_TRUE(early.visit_first);
+  EXPECT_FALSE(early.visit_second);
+}
+
+TEST(KdTree, MatchesBruteOnFlatGeometryInSplitPlanes) {
+  const Mesh mesh = axis_planes(4);
+  std::vector<Ray> rays = in_plane_rays(4, 1500, 11);
+  const std::vector<Ray> more = adversarial_rays(mesh, 1500, 12);
+  rays.insert(rays.end(), more.begin(), more.end());
+  for (const char* name : kKdNames) {
+    EXPECT_EQ(count_differences(name, mesh, rays), 0u) << name;
+    EXPECT_EQ(count_differences(name, mesh, rays, {{"max_depth", "3"}}), 0u) << name;
+  }
+  EXPECT_EQ(count_differences("kdtree-median", mesh, rays, {{"leaf_size", "1"}, {"axis", "cycle"}}), 0u);
+  EXPECT_EQ(count_differences("kdtree-sah", mesh, rays, {{"intersection_cost", "20"}, {"empty_bonus", "0.9"}}),
+            0u);
+}
+
+TEST(KdTree, MatchesBruteOnAdversarialMeshesAndInstances) {
+  Mesh mesh = adversarial_mesh(6);
+  const Mesh soup = random_soup(300, 5);
+  const uint32_t base = uint32_t(mesh.vertices.size());
+  mesh.vertices.insert(mesh.vertices.end(), soup.vertices.begin(), soup.vertices.end());
+  for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
+  mesh.vertices.push_back({std::nanf(""), 0.0f, 0.0f});  // a triangle with a NaN vertex keeps its id
+  mesh.triangles.push_back({0u, 1u, uint32_t(mesh.vertices.size() - 1)});
+  const std::vector<Ray> rays = adversarial_rays(mesh, 3000, 21);
+  for (const char* name : kKdNames) {
+    EXPECT_EQ(count_differences(name, mesh, rays), 0u) << name;
+    auto inst = testing::make_instances(random_soup(200, 9), name, 6);
+    EXPECT_EQ(testing::count_instance_differences(name, inst, adversarial_rays(random_soup(50, 1), 2000, 4)), 0u)
+        << name;
+  }
+}
+
+TEST(KdTree, EmptyMeshAndSingleTriangle) {
+  const std::vector<Ray> rays = adversarial_rays(Mesh{}, 200, 3);
+  Mesh one;
+  one.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  one.triangles = {{0, 1, 2}};
+  for (const char* name : kKdNames) {
+    EXPECT_EQ(count_differences(name, Mesh{}, rays), 0u) << name;
+    EXPECT_EQ(count_differences(name, one, adversarial_rays(one, 500, 3)), 0u) << name;
+  }
+}
+
+std::unique_ptr<Accelerator> built(const std::string& name, const Mesh& mesh,
+                                   std::map<std::string, std::string> params = {}) {
+  auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
+  auto accel = make_accelerator(name, prims, Params(std::move(params)));
+  accel->build();
+  return accel;
+}
+
+TEST(KdTree, StatisticsDescribeABinaryTree) {
+  const Mesh mesh = random_soup(3000, 17);
+  for (const char* name : kKdNames) {
+    const auto accel = built(name, mesh);
+    const BuildStats& s = accel->stats();
+    EXPECT_EQ(s.primitives, 3000u);
+    EXPECT_EQ(s.nodes, 2 * s.leaves - 1) << name;
+    EXPECT_GE(s.references, 3000u) << name;
+    EXPECT_GT(s.sah_cost, 0.0) << name;
+    uint64_t refs = 0, leaves = 0;
+    for (auto [size, count] : s.leaf_size_histogram) {
+      refs += uint64_t(size) * count;
+      leaves += count;
+    }
+    EXPECT_EQ(refs, s.references);
+    EXPECT_EQ(leaves, s.leaves);
+    EXPECT_EQ(s.bytes, s.nodes * 8 + s.references * 4);
+    EXPECT_LE(s.max_depth, uint32_t(auto_kd_depth(3000)));
+  }
+  EXPECT_LE(built("kdtree-median", mesh, {{"max_depth", "5"}})->stats().max_depth, 5u);
+}
+
+TEST(KdTree, SahTreeIsCheaperThanMedianTree) {
+  const Mesh mesh = random_soup(4000, 23, 0.01f);
+  const double sah = built("kdtree-sah", mesh)->stats().sah_cost;
+  const double median = built("kdtree-median", mesh)->stats().sah_cost;
+  EXPECT_LT(sah, median);
+}
+
+TEST(KdTree, SameTreeForOneAndTwoThreads) {
+  const Mesh mesh = random_soup(40000, 31, 0.02f);
+  const std::vector<Ray> rays = adversarial_rays(mesh, 2000, 8);
+  for (const char* name : kKdNames) {
+    BuildStats one, two;
+    std::vector<Hit> h1(rays.size()), h2(rays.size());
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+      auto a = built(name, mesh);
+      one = a->stats();
+      a->intersect(rays, h1);
+    }
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+      auto a = built(name, mesh);
+      two = a->stats();
+      a->intersect(rays, h2);
+    }
+    EXPECT_EQ(one.nodes, two.nodes) << name;
+    EXPECT_EQ(one.references, two.references) << name;
+    EXPECT_EQ(one.sah_cost, two.sah_cost) << name;
+    EXPECT_EQ(0, std::memcmp(h1.data(), h2.data(), h1.size() * sizeof(Hit))) << name;
+  }
+}
+
+TEST(KdTree, RejectsUnknownAndOutOfRangeParameters) {
+  auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(random_soup(10, 1)));
+  EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"leaf_size", "4"}})), ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"traversal_cost", "-1"}})), ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"axis", "diagonal"}})), ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"leaf_size", "0"}})), ParamError);
+  auto ok = make_accelerator("kdtree-sah", prims, testing::make_params({{"intersection_cost", "3"}}));
+  EXPECT_EQ(ok->config().at("intersection_cost"), 3.0);
+  EXPECT_TRUE(ok->config().contains("traversal_cost"));
+}
+
+}  // namespace
+}  // namespace ab
