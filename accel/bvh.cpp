@@ -32,7 +32,7 @@ struct RangeBounds {
 /// The builder: recursion over ranges of the reference array `order_`. A node for range [b, e) is
 /// written at slot p of a gapped array of 2N-1 slots; its left child is at p+1 and its right child at
 /// p + 2 (m - b), so disjoint subtrees never share slots and can be built in parallel. flatten() then
-/// compacts the slots into the final depth-first array.
+/// compacts the slots into the final array.
 class BvhBuilder {
  public:
   BvhBuilder(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids)
@@ -213,36 +213,39 @@ uint32_t BvhBuilder::split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb) 
   return b + uint32_t(best.position);
 }
 
-/// Compacts the gapped slots into a depth-first array (left child next, right child patched when it is
-/// reached) and gathers the statistics.
+/// Compacts the gapped slots into the final array: root at 0, padding at 1, then sibling pairs allocated
+/// in depth-first order (a node's children pair is allocated when the node is reached), and gathers the
+/// statistics.
 BvhBuildResult BvhBuilder::flatten() const {
   BvhBuildResult out;
   out.order = order_;
   out.stats.primitives = order_.size();
   if (slots_.empty()) return out;
   struct Item {
-    uint32_t slot, parent;
-    uint32_t depth;
+    uint32_t slot, index, depth;
   };
-  std::vector<Item> stack{{0, kInvalidId, 0}};
+  out.nodes.resize(2);
+  out.nodes[1] = BvhNode{{kInf, kInf, kInf}, 0, {-kInf, -kInf, -kInf}, 1};  // padding, never visited
+  std::vector<Item> stack{{0, 0, 0}};
   SahCostAccumulator sah(slots_[0].box().area());
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
-    const uint32_t index = uint32_t(out.nodes.size());
-    if (it.parent != kInvalidId) out.nodes[it.parent].offset = index;
-    const BvhNode& node = slots_[it.slot];
-    out.nodes.push_back(node);
+    BvhNode node = slots_[it.slot];
     if (node.is_leaf()) {
       out.stats.add_leaf(node.count, it.depth);
       sah.add_leaf(node.box().area(), node.count);
     } else {
       sah.add_interior(node.box().area());
-      stack.push_back({node.offset, index, it.depth + 1});
-      stack.push_back({it.slot + 1, kInvalidId, it.depth + 1});
+      const uint32_t pair = uint32_t(out.nodes.size());
+      out.nodes.resize(pair + 2);
+      stack.push_back({node.offset, pair + 1, it.depth + 1});
+      stack.push_back({it.slot + 1, pair, it.depth + 1});
+      node.offset = pair;
     }
+    out.nodes[it.index] = node;
   }
-  out.stats.nodes = out.nodes.size();
+  out.stats.nodes = out.nodes.size() - 1;  // without the padding node
   out.stats.sah_cost = sah.cost();
   return out;
 }
