@@ -257,7 +257,10 @@ Mesh make_soup(uint64_t triangles, uint64_t seed, Params& params) {
 
 Mesh make_slivers(uint64_t triangles, uint64_t seed, Params& params) {
   const float length = static_cast<float>(params.get_float("length", 0.3, 0.0, 100.0));
-  const float aspect = static_cast<float>(params.get_float("aspect", 1000.0, 1.0, 1e7));
+  // Default aspect (length / width): the total area stays near 1.5 (about one layer over the unit
+  // cube) whatever the count, with slivers at least 20 times longer than wide.
+  const double auto_aspect = std::max(20.0, static_cast<double>(triangles) * length * length / 3.0);
+  const float aspect = static_cast<float>(params.get_float("aspect", auto_aspect, 1.0, 1e9));
   MeshBuilder out(triangles, 3 * triangles);
   Rng rng(seed, 2);
   for (uint64_t i = 0; i < triangles; ++i) {
