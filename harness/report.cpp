@@ -170,6 +170,10 @@ void print_verification_line(std::ostream& out, const nlohmann::json& report) {
   uint64_t checks = 0;
   for (const auto& b : report.value("builds", nlohmann::json::array()))
     checks += b.value("verification", nlohmann::json::array()).size();
+  if (checks == 0) {
+    out << "verification: none (no ray sets: builds only)\n";
+    return;
+  }
   const uint64_t brute_rays = v.value("brute_rays", 0);
   out << "verification: " << checks << " configuration x ray set checks against brute force ("
       << (brute_rays ? "first " + std::to_string(brute_rays) + " rays of each set" : std::string("all rays"))
