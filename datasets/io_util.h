@@ -50,4 +50,17 @@ inline float parse_float(std::string_view token, const std::string& path, size_t
   return f;
 }
 
+/// Splits off the next whitespace-separated token of `rest` ("" at the end).
+inline std::string_view next_token(std::string_view& rest) {
+  const size_t start = rest.find_first_not_of(" \t\r");
+  if (start == std::string_view::npos) {
+    rest = {};
+    return {};
+  }
+  const size_t end = rest.find_first_of(" \t\r", start);
+  const std::string_view token = rest.substr(start, end == std::string_view::npos ? rest.size() - start : end - start);
+  rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end);
+  return token;
+}
+
 }  // namespace ab

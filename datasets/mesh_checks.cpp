@@ -18,6 +18,8 @@ const std::set<std::string> kPlyTypes = {"char",  "uchar", "short", "ushort", "i
 /// What the header check has seen of one element.
 struct PlyElement {
   std::string name;
+  long long count = 0;
+  std::vector<std::pair<std::string, bool>> properties;  ///< (name, is a list) in file order
   std::set<std::string> scalars, lists;
 };
 
@@ -34,10 +36,12 @@ void check_ply_property(std::istringstream& words, PlyElement* element, const st
     if (!(words >> count_type >> index_type >> name) || !kPlyTypes.count(count_type) || !kPlyTypes.count(index_type))
       throw InputError(ply_line_error(path, line, "malformed list property"));
     element->lists.insert(name);
+    element->properties.emplace_back(name, true);
   } else {
     if (!(words >> name) || !kPlyTypes.count(type))
       throw InputError(ply_line_error(path, line, "malformed property (unknown type '" + type + "')"));
     element->scalars.insert(name);
+    element->properties.emplace_back(name, false);
   }
 }
 
@@ -53,6 +57,69 @@ void check_ply_elements(const std::vector<PlyElement>& elements, const std::stri
     if (e.name == "face" && e.lists.empty()) throw InputError(path + ": the face element has no list of vertex indices");
   }
   if (!vertex) throw InputError(path + ": no vertex element in the PLY header");
+}
+
+/// Parses an integer token of an ASCII PLY body, or throws naming the line.
+long long ply_integer(std::string_view token, const std::string& path, size_t line) {
+  long long value = 0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (token.empty() || ec != std::errc() || end != token.data() + token.size())
+    throw InputError(ply_line_error(path, line, "'" + std::string(token) + "' is not an integer"));
+  return value;
+}
+
+/// Checks one face list: at least three corners, each an index of an existing vertex.
+void check_ply_face_list(std::string_view& rest, long long vertices, long long face, const std::string& path,
+                         size_t line) {
+  const long long corners = ply_integer(next_token(rest), path, line);
+  if (corners < 3) throw InputError(ply_line_error(path, line, "face " + std::to_string(face) + " has fewer than three vertices"));
+  for (long long k = 0; k < corners; ++k) {
+    const long long i = ply_integer(next_token(rest), path, line);
+    if (i < 0 || i >= vertices)
+      throw InputError(ply_line_error(path, line, "face " + std::to_string(face) + " refers to vertex " +
+                                                      std::to_string(i) + ", but there are only " +
+                                                      std::to_string(vertices) + " vertices"));
+  }
+}
+
+/// Checks one element line of an ASCII PLY body against the element's properties.
+void check_ply_ascii_line(std::string_view rest, const PlyElement& e, long long index, long long vertices,
+                          const std::string& path, size_t line) {
+  for (const auto& [name, list] : e.properties) {
+    if (list && e.name == "face" && (name == "vertex_indices" || name == "vertex_index")) {
+      check_ply_face_list(rest, vertices, index + 1, path, line);
+    } else if (list) {
+      const long long n = ply_integer(next_token(rest), path, line);
+      for (long long k = 0; k < n; ++k) parse_float(next_token(rest), path, line);
+    } else {
+      const std::string_view token = next_token(rest);
+      if (token.empty()) throw InputError(ply_line_error(path, line, "too few values for element " + e.name));
+      const float f = parse_float(token, path, line);
+      if (e.name == "vertex" && (name == "x" || name == "y" || name == "z") && !std::isfinite(f))
+        throw InputError(ply_line_error(path, line, "vertex " + std::to_string(index + 1) +
+                                                        " has a NaN or infinite coordinate"));
+    }
+  }
+}
+
+/// OpenMesh's ASCII PLY reader turns an unparsable number into silent garbage, so the body is
+/// checked first: one line per element instance, numbers that parse, finite x/y/z, faces of at
+/// least three in-range indices, and no missing lines.
+void check_ply_ascii_body(std::istream& in, const std::vector<PlyElement>& elements, const std::string& path,
+                          size_t line) {
+  long long vertices = 0;
+  std::string text;
+  for (const PlyElement& e : elements) {
+    if (e.name == "vertex") vertices = e.count;
+    for (long long k = 0; k < e.count;) {
+      if (!std::getline(in, text))
+        throw InputError(path + ": truncated: " + e.name + " " + std::to_string(k + 1) + " of " +
+                         std::to_string(e.count) + " is missing");
+      ++line;
+      if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+      check_ply_ascii_line(text, e, k++, vertices, path, line);
+    }
+  }
 }
 
 /// Reads the next non-empty, non-comment line of an OFF file into `words`; false at the end.
@@ -109,12 +176,12 @@ void check_off_faces(std::istream& in, long long count, long long vertices, cons
 
 }  // namespace
 
-void check_ply_header(const std::string& path) {
+void check_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string text, keyword;
   if (!std::getline(in, text) || text.substr(0, 3) != "ply") throw InputError(path + ": not a PLY file (no 'ply' magic)");
   std::vector<PlyElement> elements;
-  bool format = false;
+  bool format = false, ascii = false;
   for (size_t line = 2; line < 100000 && std::getline(in, text); ++line) {
     if (!text.empty() && text.back() == '\r') text.pop_back();
     std::istringstream words(text);
@@ -122,6 +189,7 @@ void check_ply_header(const std::string& path) {
     if (keyword == "end_header") {
       if (!format) throw InputError(path + ": the PLY header has no format line");
       check_ply_elements(elements, path);
+      if (ascii) check_ply_ascii_body(in, elements, path, line);
       return;
     }
     if (keyword == "format") {
@@ -130,10 +198,12 @@ void check_ply_header(const std::string& path) {
       if (kind != "ascii" && kind != "binary_little_endian" && kind != "binary_big_endian")
         throw InputError(ply_line_error(path, line, "unknown PLY format '" + kind + "'"));
       format = true;
+      ascii = kind == "ascii";
     } else if (keyword == "element") {
       PlyElement e;
-      long long count = -1;
-      if (!(words >> e.name >> count) || count < 0) throw InputError(ply_line_error(path, line, "malformed element line"));
+      e.count = -1;
+      if (!(words >> e.name >> e.count) || e.count < 0)
+        throw InputError(ply_line_error(path, line, "malformed element line"));
       elements.push_back(e);
     } else if (keyword == "property") {
       check_ply_property(words, elements.empty() ? nullptr : &elements.back(), path, line);

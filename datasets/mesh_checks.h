@@ -8,9 +8,10 @@
 
 namespace ab {
 
-/// Validates a PLY header: the magic, a known format, element and property lines with known types,
-/// a vertex element with x, y, z, a list property on the face element, and end_header.
-void check_ply_header(const std::string& path);
+/// Validates a PLY file: the header (magic, a known format, element and property lines with known
+/// types, a vertex element with x, y, z, a list property on the face element, end_header) and, for
+/// ASCII PLY, the body (numbers, finite coordinates, face indices in range, no missing lines).
+void check_ply(const std::string& path);
 
 /// Validates a plain ASCII OFF file ("OFF" keyword; variants and binary OFF are left to OpenMesh):
 /// counts, three finite coordinates per vertex, faces of at least three in-range indices, and no

@@ -51,8 +51,8 @@ class MeshImporter : public OpenMesh::IO::BaseImporter {
     const size_t face = faces_++;
     for (const VertexHandle& vh : indices)
       if (!vh.is_valid() || static_cast<size_t>(vh.idx()) >= mesh_.vertices.size()) {
-        fail("face " + std::to_string(face + 1) + " refers to vertex " + std::to_string(vh.idx() + 1) +
-             ", but there are only " + std::to_string(mesh_.vertices.size()) + " vertices");
+        fail("face " + std::to_string(face + 1) + " refers to vertex " + std::to_string(vh.idx()) +
+             " (0-based), but there are only " + std::to_string(mesh_.vertices.size()) + " vertices");
         return FaceHandle(static_cast<int>(face));
       }
     if (indices.size() < 3) fail("face " + std::to_string(face + 1) + " has fewer than three vertices");

@@ -216,7 +216,7 @@ Mesh read_mesh(const std::string& path) {
   } else if (ext == "obj") {
     mesh = read_obj(path);
   } else {
-    if (ext == "ply") check_ply_header(path);
+    if (ext == "ply") check_ply(path);
     else check_ascii_off(path);
     MeshImporter importer(mesh);
     read_through_openmesh(path, importer);

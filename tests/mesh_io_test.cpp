@@ -261,6 +261,8 @@ TEST_F(MeshIoTest, NonFiniteCoordinates) {
   const float nan = std::nanf("");
   std::memcpy(&ply[at], &nan, 4);
   expect_input_error(write("nan.ply", ply), "NaN or infinite");
+  expect_input_error(write("nan2.ply", ply_header("ascii", 3, 1) + "0 0 0\nnan 1 0\n0 1 0\n3 0 1 2\n"),
+                     "NaN or infinite");
   expect_input_error(write("nan.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n"
                                       "vertex 0 1 0\nendloop\nendfacet\nendsolid x\n"),
                      "NaN or infinite");
@@ -270,6 +272,10 @@ TEST_F(MeshIoTest, IndexOutOfRange) {
   expect_input_error(write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n"), "vertex");
   expect_input_error(write("bad.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 7\n"), "vertex");
   expect_input_error(write("bad.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "vertex");
+  expect_input_error(write("neg.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"), "vertex -1");
+  std::string binary = ply_binary_text(false);
+  binary[binary.size() - 1] = 0x7F;  // last corner of the last face becomes a huge index
+  expect_input_error(write("bad_binary.ply", binary), "vertex");
 }
 
 TEST_F(MeshIoTest, TruncatedBinaryFiles) {
@@ -288,6 +294,9 @@ TEST_F(MeshIoTest, MalformedContent) {
   expect_input_error(write("m.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"), "end_header");
   expect_input_error(write("n.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n"),
                      "x, y or z");
+  expect_input_error(write("p.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"), "not a number");
+  expect_input_error(write("q.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n"), "truncated");
+  expect_input_error(write("r.ply", "PLY?\n"), "not a PLY file");
   expect_input_error(write("m.obj", "v 0 0\n"), "three coordinates");
   expect_input_error(write("n.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n"), "fewer than three");
   expect_input_error(write("o.obj", "v 0 0 0\nv 1 0 0\nv 1 1 1\nf 1 x 3\n"), "not a vertex index");
