@@ -4,7 +4,6 @@
 #include "harness/hitfile.h"
 #include "harness/options.h"
 #include "harness/target.h"
-#include "tracer/workload.h"
 
 #include <memory>
 
@@ -30,12 +29,8 @@ const CommandRegistrar kRays{{"rays", "write a ray set (.rays)", 30, [](CLI::App
                                 app.add_option("-o,--output", a->output, "output .rays file")->required();
                                 return [a] {
                                   const Target target = load_target(a->target.mesh, a->target.scene);
-                                  const RayTarget rt = ray_target(target);
                                   // Scenes: the tracer's own kinds (camera and lights of the scene).
-                                  const std::vector<Ray> rays =
-                                      target.scene && is_scene_ray_kind(a->kind)
-                                          ? make_scene_rays(*target.scene, rt.trace, a->kind, a->count, a->seed)
-                                          : make_rays(a->kind, rt, a->count, a->seed);
+                                  const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed);
                                   write_rays(a->output, rays);
                                   return 0;
                                 };

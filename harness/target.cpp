@@ -5,6 +5,7 @@
 #include "datasets/mesh_io.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"
+#include "tracer/workload.h"
 
 namespace ab {
 
@@ -73,6 +74,12 @@ RayTarget ray_target(const Target& target) {
     return len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
   };
   return rt;
+}
+
+std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count, uint64_t seed) {
+  const RayTarget rt = ray_target(target);
+  if (target.scene && is_scene_ray_kind(kind)) return make_scene_rays(*target.scene, rt.trace, kind, count, seed);
+  return make_rays(kind, rt, count, seed);
 }
 
 HitTriangleFn hit_triangles(const Target& target) {

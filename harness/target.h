@@ -33,6 +33,11 @@ Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name);
 std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name, Params params,
                                                      const std::string& top = "", const std::string& bottom = "");
 
+/// Exactly `count` rays of `kind` for the target: for a scene, the tracer's kinds (primary, dof, shadow,
+/// glossy, diffuse: tracer/workload.h) use its camera and lights; every other kind (and every kind for
+/// a mesh) comes from make_rays. Throws InputError for an unknown kind.
+std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count, uint64_t seed);
+
 /// What ray generation needs of the target (bounds, a closest-hit trace through a fast structure of the
 /// project, normals at hits).
 RayTarget ray_target(const Target& target);
