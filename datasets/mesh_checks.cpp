@@ -122,54 +122,59 @@ void check_ply_ascii_body(std::istream& in, const std::vector<PlyElement>& eleme
   }
 }
 
-/// Reads the next non-empty, non-comment line of an OFF file into `words`; false at the end.
-bool next_off_line(std::istream& in, std::istringstream& words, size_t& line) {
+/// Line reader for OFF: skips blank lines and # comments, counts lines, and hands out tokens.
+struct OffLines {
+  std::istream& in;
+  const std::string& path;
+  size_t line = 0;
   std::string text;
-  while (std::getline(in, text)) {
-    ++line;
-    text = text.substr(0, text.find('#'));
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    words.clear();
-    words.str(text);
-    return true;
+  std::string_view rest;
+
+  /// Moves to the next non-empty, non-comment line; false at the end of the file.
+  bool next() {
+    while (std::getline(in, text)) {
+      ++line;
+      rest = std::string_view(text).substr(0, text.find('#'));
+      if (rest.find_first_not_of(" \t\r") != std::string_view::npos) return true;
+    }
+    return false;
   }
-  return false;
-}
+  /// The next token of the current line ("" when there is none).
+  std::string_view token() { return next_token(rest); }
+  /// The next token as a non-negative integer, or throws.
+  long long integer(const char* what) {
+    const std::string_view t = token();
+    long long value = -1;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+    if (t.empty() || ec != std::errc() || end != t.data() + t.size() || value < 0) throw error(std::string("expected ") + what);
+    return value;
+  }
+  /// An error naming the file and current line.
+  InputError error(const std::string& what) const { return InputError(path + ":" + std::to_string(line) + ": " + what); }
+};
 
-/// Reads a non-negative integer token, or throws.
-long long off_integer(std::istringstream& words, const std::string& path, size_t line, const char* what) {
-  std::string token;
-  long long value = -1;
-  if (words >> token) std::from_chars(token.data(), token.data() + token.size(), value);
-  if (value < 0) throw InputError(path + ":" + std::to_string(line) + ": expected " + what);
-  return value;
-}
-
-void check_off_vertices(std::istream& in, long long count, const std::string& path, size_t& line) {
-  std::istringstream words;
-  std::string token;
+void check_off_vertices(OffLines& off, long long count) {
   for (long long v = 0; v < count; ++v) {
-    if (!next_off_line(in, words, line)) throw InputError(path + ": truncated: vertex " + std::to_string(v + 1) + " is missing");
+    if (!off.next()) throw InputError(off.path + ": truncated: vertex " + std::to_string(v + 1) + " is missing");
     for (int k = 0; k < 3; ++k) {
-      if (!(words >> token)) throw InputError(path + ":" + std::to_string(line) + ": a vertex needs three coordinates");
-      if (!std::isfinite(parse_float(token, path, line)))
-        throw InputError(path + ":" + std::to_string(line) + ": vertex " + std::to_string(v + 1) +
-                         " has a NaN or infinite coordinate");
+      const std::string_view t = off.token();
+      if (t.empty()) throw off.error("a vertex needs three coordinates");
+      if (!std::isfinite(parse_float(t, off.path, off.line)))
+        throw off.error("vertex " + std::to_string(v + 1) + " has a NaN or infinite coordinate");
     }
   }
 }
 
-void check_off_faces(std::istream& in, long long count, long long vertices, const std::string& path, size_t& line) {
-  std::istringstream words;
+void check_off_faces(OffLines& off, long long count, long long vertices) {
   for (long long f = 0; f < count; ++f) {
-    if (!next_off_line(in, words, line)) throw InputError(path + ": truncated: face " + std::to_string(f + 1) + " is missing");
-    const long long corners = off_integer(words, path, line, "a corner count");
-    if (corners < 3) throw InputError(path + ":" + std::to_string(line) + ": face has fewer than three vertices");
+    if (!off.next()) throw InputError(off.path + ": truncated: face " + std::to_string(f + 1) + " is missing");
+    const long long corners = off.integer("a corner count");
+    if (corners < 3) throw off.error("face " + std::to_string(f + 1) + " has fewer than three vertices");
     for (long long k = 0; k < corners; ++k) {
-      const long long i = off_integer(words, path, line, "a vertex index");
+      const long long i = off.integer("a vertex index");
       if (i >= vertices)
-        throw InputError(path + ":" + std::to_string(line) + ": face " + std::to_string(f + 1) + " refers to vertex " +
-                         std::to_string(i) + ", but there are only " + std::to_string(vertices) + " vertices");
+        throw off.error("face " + std::to_string(f + 1) + " refers to vertex " + std::to_string(i) +
+                        ", but there are only " + std::to_string(vertices) + " vertices");
     }
   }
 }
@@ -216,24 +221,17 @@ void check_ply(const std::string& path) {
 
 void check_ascii_off(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::istringstream words;
-  size_t line = 0;
-  std::string keyword;
-  if (!next_off_line(in, words, line) || !(words >> keyword) || keyword.find("OFF") == std::string::npos)
-    throw InputError(path + ": not an OFF file (no OFF keyword)");
+  OffLines off{in, path, 0, {}, {}};
+  const std::string_view keyword = off.next() ? off.token() : std::string_view{};
+  if (keyword.find("OFF") == std::string_view::npos) throw InputError(path + ": not an OFF file (no OFF keyword)");
   if (keyword != "OFF") return;  // COFF, NOFF, 4OFF, ... : left to OpenMesh
-  std::vector<std::string> counts;
-  for (std::string t; words >> t;) counts.push_back(t);
-  if (!counts.empty() && counts[0] == "BINARY") return;
-  if (counts.empty()) {
-    if (!next_off_line(in, words, line)) throw InputError(path + ": truncated: no vertex and face counts");
-    for (std::string t; words >> t;) counts.push_back(t);
-  }
-  std::istringstream count_words(counts.size() >= 2 ? counts[0] + " " + counts[1] : std::string());
-  const long long vertices = off_integer(count_words, path, line, "the vertex count");
-  const long long faces = off_integer(count_words, path, line, "the face count");
-  check_off_vertices(in, vertices, path, line);
-  check_off_faces(in, faces, vertices, path, line);
+  if (off.rest.find_first_not_of(" \t\r") == std::string_view::npos && !off.next())
+    throw InputError(path + ": truncated: no vertex and face counts");
+  if (off.rest.find("BINARY") != std::string_view::npos) return;  // binary OFF: left to OpenMesh
+  const long long vertices = off.integer("the vertex count");
+  const long long faces = off.integer("the face count");
+  check_off_vertices(off, vertices);
+  check_off_faces(off, faces, vertices);
 }
 
 }  // namespace ab
