@@ -109,6 +109,19 @@ TEST(Generators, CityscapeHasLatticeCoordinatesDuplicatesAndDegenerates) {
   }
 }
 
+TEST(Generators, OnlyCityscapeHasZeroAreaTriangles) {
+  for (const GeneratorInfo& g : generators()) {
+    if (g.name == "cityscape") continue;
+    const Mesh m = generate_mesh(g.name, 20000, 3, Params());
+    size_t zero_area = 0;
+    for (size_t i = 0; i < m.size(); ++i) {
+      const Triangle t = m.triangle(i);
+      zero_area += glm::cross(t.v1 - t.v0, t.v2 - t.v0) == vec3(0.0f);
+    }
+    EXPECT_EQ(zero_area, 0u) << g.name;
+  }
+}
+
 TEST(Generators, StadiumObjectIsTinyAndHoldsMostTriangles) {
   const Mesh m = generate_mesh("stadium", 10000, 0, Params());
   const AABB room = m.bounds();
