@@ -33,7 +33,7 @@ TEST(EmbreeAgreement, BruteAgreesWithEmbreeOnEveryGeneratorAndRayKind) {
       size_t found = 0;
       for (const Hit& h : ours) found += h.found();
       if (kind.name == "primary") {
-        EXPECT_GT(found, rays.size() / 10) << gen.name << ": primary rays should mostly hit";
+        EXPECT_GT(found, 0u) << gen.name << ": no primary ray hits, so nothing was compared";
       }
     }
   }
