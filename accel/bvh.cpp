@@ -29,21 +29,30 @@ struct RangeBounds {
   }
 };
 
-/// The builder: recursion over ranges of the reference array `order_`. A node for range [b, e) is
+/// A primitive as the builder moves it around: bounds, centroid and id together, so the passes over a
+/// range read contiguous memory.
+struct BuildRef {
+  AABB box;
+  vec3 centroid;
+  uint32_t id;
+};
+
+/// The builder: recursion over ranges of the reference array `refs_`. A node for range [b, e) is
 /// written at slot p of a gapped array of 2N-1 slots; its left child is at p+1 and its right child at
 /// p + 2 (m - b), so disjoint subtrees never share slots and can be built in parallel. flatten() then
 /// compacts the slots into the final array.
 class BvhBuilder {
  public:
   BvhBuilder(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids)
-      : method_(method), config_(config), bounds_(bounds), centroids_(centroids), order_(bounds.size()),
-        slots_(bounds.empty() ? 0 : 2 * bounds.size() - 1) {
-    std::iota(order_.begin(), order_.end(), 0u);
+      : method_(method), config_(config), refs_(bounds.size()), slots_(bounds.empty() ? 0 : 2 * bounds.size() - 1) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, refs_.size(), kGrain), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) refs_[i] = {bounds[i], centroids[i], uint32_t(i)};
+    });
   }
 
   /// Builds the tree and returns the flattened result.
   BvhBuildResult run() {
-    if (!order_.empty()) build(0, 0, uint32_t(order_.size()), 0);
+    if (!refs_.empty()) build(0, 0, uint32_t(refs_.size()), 0);
     return flatten();
   }
 
@@ -60,9 +69,7 @@ class BvhBuilder {
 
   BvhMethod method_;
   BvhConfig config_;
-  std::span<const AABB> bounds_;
-  std::span<const vec3> centroids_;
-  std::vector<uint32_t> order_;
+  std::vector<BuildRef> refs_;
   std::vector<BvhNode> slots_;
 };
 
@@ -93,8 +100,8 @@ void BvhBuilder::build(uint32_t p, uint32_t b, uint32_t e, int depth) {
 RangeBounds BvhBuilder::range_bounds(uint32_t b, uint32_t e) const {
   auto body = [&](const tbb::blocked_range<uint32_t>& r, RangeBounds acc) {
     for (uint32_t k = r.begin(); k < r.end(); ++k) {
-      acc.bounds.extend(bounds_[order_[k]]);
-      acc.centroids.extend(centroids_[order_[k]]);
+      acc.bounds.extend(refs_[k].box);
+      acc.centroids.extend(refs_[k].centroid);
     }
     return acc;
   };
@@ -127,9 +134,9 @@ uint32_t BvhBuilder::split_median(uint32_t b, uint32_t e, const RangeBounds& rb)
   const int axis = rb.centroids.longest_axis();
   const uint32_t m = b + n / 2;
   if (!(rb.centroids.extent()[axis] > 0.0f)) return m;  // all centroids coincide: split by position
-  std::nth_element(order_.begin() + b, order_.begin() + m, order_.begin() + e, [&](uint32_t x, uint32_t y) {
-    const float cx = centroids_[x][axis], cy = centroids_[y][axis];
-    return cx != cy ? cx < cy : x < y;
+  std::nth_element(refs_.begin() + b, refs_.begin() + m, refs_.begin() + e, [&](const BuildRef& x, const BuildRef& y) {
+    const float cx = x.centroid[axis], cy = y.centroid[axis];
+    return cx != cy ? cx < cy : x.id < y.id;
   });
   return m;
 }
@@ -149,8 +156,8 @@ std::vector<SahBin> BvhBuilder::bin_range(uint32_t b, uint32_t e, const BinMappi
   auto body = [&](const tbb::blocked_range<uint32_t>& r, std::vector<SahBin> acc) {
     if (acc.empty()) acc.resize(3 * nb);
     for (uint32_t k = r.begin(); k < r.end(); ++k) {
-      const uint32_t id = order_[k];
-      for (int a = 0; a < 3; ++a) acc[a * nb + map.bin(a, centroids_[id][a])].add(bounds_[id]);
+      const BuildRef& ref = refs_[k];
+      for (int a = 0; a < 3; ++a) acc[a * nb + map.bin(a, ref.centroid[a])].add(ref.box);
     }
     return acc;
   };
@@ -165,7 +172,9 @@ std::vector<SahBin> BvhBuilder::bin_range(uint32_t b, uint32_t e, const BinMappi
 // Binned SAH (Wald 2007): centroids are projected into equal-width bins on each axis, the bins are
 // swept to evaluate every bin boundary, and the range is partitioned at the cheapest one.
 uint32_t BvhBuilder::split_binned(uint32_t b, uint32_t e, const RangeBounds& rb) {
-  const BinMapping map(rb.centroids, config_.bins);
+  // Small nodes use as many bins as primitives (more could not separate them any better on average, and
+  // evaluating unused boundaries dominates the cost near the leaves).
+  const BinMapping map(rb.centroids, std::min(config_.bins, std::max(4, int(e - b))));
   const std::vector<SahBin> bins = bin_range(b, e, map);
   SahSplit best;
   const float area = rb.bounds.area();
@@ -173,35 +182,36 @@ uint32_t BvhBuilder::split_binned(uint32_t b, uint32_t e, const RangeBounds& rb)
     if (map.scale[a] > 0.0f) best_bin_split(&bins[a * size_t(map.bins)], map.bins, a, area, config_.costs, best);
   const uint32_t d = decide(b, e, best);
   if (d != e) return d;
-  const auto mid = std::partition(order_.begin() + b, order_.begin() + e, [&](uint32_t id) {
-    return map.bin(best.axis, centroids_[id][best.axis]) < best.position;
+  const auto mid = std::partition(refs_.begin() + b, refs_.begin() + e, [&](const BuildRef& ref) {
+    return map.bin(best.axis, ref.centroid[best.axis]) < best.position;
   });
-  return uint32_t(mid - order_.begin());
+  return uint32_t(mid - refs_.begin());
 }
 
 // Full sweep SAH (MacDonald and Booth 1990, as the reference in Wald 2007): on each axis the centroids
 // are sorted and every split between consecutive primitives is evaluated with exact child bounds.
 uint32_t BvhBuilder::split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb) {
   const uint32_t n = e - b;
-  std::vector<uint32_t> sorted(order_.begin() + b, order_.begin() + e), best_sorted;
+  std::vector<uint32_t> sorted(n), best_sorted;  // positions in refs_
+  std::iota(sorted.begin(), sorted.end(), b);
   std::vector<float> right_area(n);
   SahSplit best;
   const float area = rb.bounds.area();
   for (int a = 0; a < 3; ++a) {
     if (!(rb.centroids.extent()[a] > 0.0f)) continue;  // all centroids on one plane: no split on this axis
     std::sort(sorted.begin(), sorted.end(), [&](uint32_t x, uint32_t y) {
-      const float cx = centroids_[x][a], cy = centroids_[y][a];
-      return cx != cy ? cx < cy : x < y;
+      const float cx = refs_[x].centroid[a], cy = refs_[y].centroid[a];
+      return cx != cy ? cx < cy : refs_[x].id < refs_[y].id;
     });
     AABB acc;
     for (uint32_t i = n - 1; i > 0; --i) {
-      acc.extend(bounds_[sorted[i]]);
+      acc.extend(refs_[sorted[i]].box);
       right_area[i] = acc.area();
     }
     acc = AABB{};
     const float before = best.cost;
     for (uint32_t i = 1; i < n; ++i) {
-      acc.extend(bounds_[sorted[i - 1]]);
+      acc.extend(refs_[sorted[i - 1]].box);
       const float c = config_.costs.split(area, acc.area(), i, right_area[i], n - i);
       if (c < best.cost) best = {a, int(i), c};
     }
@@ -209,7 +219,9 @@ uint32_t BvhBuilder::split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb) 
   }
   const uint32_t d = decide(b, e, best);
   if (d != e) return d;
-  std::copy(best_sorted.begin(), best_sorted.end(), order_.begin() + b);
+  std::vector<BuildRef> permuted(n);
+  for (uint32_t i = 0; i < n; ++i) permuted[i] = refs_[best_sorted[i]];
+  std::copy(permuted.begin(), permuted.end(), refs_.begin() + b);
   return b + uint32_t(best.position);
 }
 
@@ -218,8 +230,9 @@ uint32_t BvhBuilder::split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb) 
 /// statistics.
 BvhBuildResult BvhBuilder::flatten() const {
   BvhBuildResult out;
-  out.order = order_;
-  out.stats.primitives = order_.size();
+  out.order.resize(refs_.size());
+  for (size_t k = 0; k < refs_.size(); ++k) out.order[k] = refs_[k].id;
+  out.stats.primitives = refs_.size();
   if (slots_.empty()) return out;
   struct Item {
     uint32_t slot, index, depth;

@@ -75,8 +75,8 @@ struct SahSplit {
 /// left to right evaluating every boundary (Wald 2007). Updates best when a cheaper split is found.
 inline void best_bin_split(const SahBin* bins, int n, int axis, float parent_area, const SahCosts& costs,
                            SahSplit& best) {
-  std::array<float, 256> right_area{};
-  std::array<uint32_t, 256> right_count{};
+  std::array<float, 256> right_area;     // only [1, n) is written and read: no zeroing (this runs per node)
+  std::array<uint32_t, 256> right_count;
   AABB acc;
   uint32_t cnt = 0;
   for (int i = n - 1; i > 0; --i) {
