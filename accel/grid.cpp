@@ -80,11 +80,13 @@ void insert_primitive(const GridLayout& g, uint32_t id, const AABB& b, float mar
     lo[a] = g.cell_of(a, b.lo[a] - margin);
     hi[a] = g.cell_of(a, b.hi[a] + margin);
   }
-  const bool single = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2];
+  // A range that is one cell thick on two axes needs no test: the primitive is connected, so it meets every
+  // slab its bounds span (a cell added only because of the margin is harmless, just one more reference).
+  const bool line = (lo[0] != hi[0]) + (lo[1] != hi[1]) + (lo[2] != hi[2]) <= 1;
   for (int z = lo[2]; z <= hi[2]; ++z)
     for (int y = lo[1]; y <= hi[1]; ++y)
       for (int x = lo[0]; x <= hi[0]; ++x)
-        if (single || overlaps(id, inflate_for_insertion(g.cell_box(x, y, z))))
+        if (line || overlaps(id, inflate_for_insertion(g.cell_box(x, y, z))))
           out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
 }
 

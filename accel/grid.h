@@ -15,6 +15,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace ab {
@@ -174,7 +175,13 @@ class Grid final : public AcceleratorBase<Grid<P>> {
       for (size_t i = r.begin(); i < r.end(); ++i) boxes[i] = prims_->bounds(i);
     });
     const P& prims = *prims_;
-    cells_ = build_grid_cells(layout_, boxes, [&prims](uint32_t i, const AABB& b) { return prims.overlaps(i, b); });
+    cells_ = build_grid_cells(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
+      if constexpr (std::is_same_v<P, TrianglePrims>) {  // fast exact accept: a vertex inside the box
+        const Triangle& t = prims.triangle(i);
+        if (b.contains(t.v0) || b.contains(t.v1) || b.contains(t.v2)) return true;
+      }
+      return prims.overlaps(i, b);
+    });
     fill_stats();
   }
 
