@@ -1,13 +1,13 @@
 #include "accel/embree_scene.h"
 
-#include "accel/error.h"
-#include "accel/instances.h"
-
 #include <embree3/rtcore.h>
-#include <glm/gtc/type_ptr.hpp>
 
+#include <glm/gtc/type_ptr.hpp>
 #include <mutex>
 #include <string>
+
+#include "accel/error.h"
+#include "accel/instances.h"
 
 namespace ab {
 

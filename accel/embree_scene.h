@@ -2,14 +2,13 @@
 // reference that `verify --scene` checks the project's two-level structures against.
 #pragma once
 
+#include <glm/glm.hpp>
+#include <memory>
+#include <vector>
+
 #include "accel/accelerator.h"
 #include "accel/mesh.h"
 #include "accel/params.h"
-
-#include <glm/glm.hpp>
-
-#include <memory>
-#include <vector>
 
 namespace ab {
 

@@ -1,9 +1,9 @@
 // `accelbench flatten --scene F -o FILE.obj`: the scene's instanced geometry as one world-space mesh.
+#include <memory>
+
 #include "datasets/mesh_io.h"
 #include "harness/cli.h"
 #include "tracer/scene.h"
-
-#include <memory>
 
 namespace ab {
 namespace {

@@ -2,6 +2,13 @@
 //  [--width W] [--height H] [--max-depth D] [--seed S] [--threads T]
 //  [--heatmap [--metric nodes|prims] [--scale-max V]]
 //  [--param k=v ...] -o FILE.png`
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
 #include "accel/error.h"
 #include "accel/registry.h"
 #include "harness/cli.h"
@@ -10,13 +17,6 @@
 #include "tracer/heatmap.h"
 #include "tracer/integrator.h"
 #include "tracer/scene.h"
-
-#include <unistd.h>
-
-#include <chrono>
-#include <cstdio>
-#include <iostream>
-#include <memory>
 
 namespace ab {
 namespace {
@@ -76,50 +76,48 @@ int run_render(const RenderArgs& a) {
     const HeatmapMetric m = a.metric == "prims" ? HeatmapMetric::kPrims : HeatmapMetric::kNodes;
     const std::vector<float> work = render_work(scene, *accel, opt, m);
     out = heatmap_image(work, opt.width, opt.height,
-                        accel->name() + (m == HeatmapMetric::kNodes ? " nodes/ray" : " prims/ray"), a.scale_max);
+                        accel->name() + (m == HeatmapMetric::kNodes ? " nodes/ray" : " prims/ray"),
+                        a.scale_max);
     counts.camera_rays = uint64_t(opt.width) * uint64_t(opt.height) * uint64_t(opt.spp);
   } else {
     out = to_srgb8(render(scene, *accel, opt, &counts));
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_png(out, a.output);
-  std::printf("%s: %dx%d, %d spp, %s: build %.3f s, render %.3f s, %llu rays (%.2f Mrays/s)\n", a.output.c_str(),
-              opt.width, opt.height, opt.spp, accel->name().c_str(), accel->stats().build_seconds, seconds,
-              static_cast<unsigned long long>(counts.total()), seconds > 0 ? double(counts.total()) / seconds / 1e6 : 0.0);
+  std::printf("%s: %dx%d, %d spp, %s: build %.3f s, render %.3f s, %llu rays (%.2f Mrays/s)\n",
+              a.output.c_str(), opt.width, opt.height, opt.spp, accel->name().c_str(),
+              accel->stats().build_seconds, seconds, static_cast<unsigned long long>(counts.total()),
+              seconds > 0 ? double(counts.total()) / seconds / 1e6 : 0.0);
   return 0;
 }
 
-const CommandRegistrar kRender{{"render", "render a scene with the tracer (PNG), or a heatmap of traversal work", 70,
-                                [](CLI::App& app) -> std::function<int()> {
-                                  auto a = std::make_shared<RenderArgs>();
-                                  app.add_option("--scene", a->scene, "scene file (.xml)")
-                                      ->required()
-                                      ->check(CLI::ExistingFile);
-                                  app.add_option("--accel", a->accel, "accelerator at both levels (default bvh-sah)")
-                                      ->check(accelerator_name_validator());
-                                  app.add_option("--accel-top", a->accel_top, "top-level accelerator")
-                                      ->check(accelerator_name_validator());
-                                  app.add_option("--accel-bottom", a->accel_bottom, "per-mesh accelerator")
-                                      ->check(accelerator_name_validator());
-                                  app.add_option("--spp", a->spp, "samples per pixel (default: the scene's)")
-                                      ->check(CLI::Range(1, 65536));
-                                  app.add_option("--width", a->width, "image width")->check(CLI::Range(1, 16384));
-                                  app.add_option("--height", a->height, "image height")->check(CLI::Range(1, 16384));
-                                  app.add_option("--max-depth", a->max_depth, "recursion limit")
-                                      ->check(CLI::Range(1, 64));
-                                  app.add_option("--seed", a->seed, "random seed");
-                                  app.add_option("--threads", a->threads, "threads (0: all cores)")
-                                      ->check(CLI::Range(0, 1024));
-                                  app.add_flag("--heatmap", a->heatmap, "false-colour traversal work per pixel");
-                                  app.add_option("--metric", a->metric, "heatmap metric")
-                                      ->check(CLI::IsMember({"nodes", "prims"}));
-                                  app.add_option("--scale-max", a->scale_max,
-                                                 "heatmap: value at the top of the colour scale (default: the image's maximum)")
-                                      ->check(CLI::PositiveNumber);
-                                  app.add_option("--param", a->params, "accelerator parameter k=v (repeatable)");
-                                  app.add_option("-o,--output", a->output, "output .png file")->required();
-                                  return [a] { return run_render(*a); };
-                                }}};
+const CommandRegistrar kRender{
+    {"render", "render a scene with the tracer (PNG), or a heatmap of traversal work", 70,
+     [](CLI::App& app) -> std::function<int()> {
+       auto a = std::make_shared<RenderArgs>();
+       app.add_option("--scene", a->scene, "scene file (.xml)")->required()->check(CLI::ExistingFile);
+       app.add_option("--accel", a->accel, "accelerator at both levels (default bvh-sah)")
+           ->check(accelerator_name_validator());
+       app.add_option("--accel-top", a->accel_top, "top-level accelerator")
+           ->check(accelerator_name_validator());
+       app.add_option("--accel-bottom", a->accel_bottom, "per-mesh accelerator")
+           ->check(accelerator_name_validator());
+       app.add_option("--spp", a->spp, "samples per pixel (default: the scene's)")
+           ->check(CLI::Range(1, 65536));
+       app.add_option("--width", a->width, "image width")->check(CLI::Range(1, 16384));
+       app.add_option("--height", a->height, "image height")->check(CLI::Range(1, 16384));
+       app.add_option("--max-depth", a->max_depth, "recursion limit")->check(CLI::Range(1, 64));
+       app.add_option("--seed", a->seed, "random seed");
+       app.add_option("--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
+       app.add_flag("--heatmap", a->heatmap, "false-colour traversal work per pixel");
+       app.add_option("--metric", a->metric, "heatmap metric")->check(CLI::IsMember({"nodes", "prims"}));
+       app.add_option("--scale-max", a->scale_max,
+                      "heatmap: value at the top of the colour scale (default: the image's maximum)")
+           ->check(CLI::PositiveNumber);
+       app.add_option("--param", a->params, "accelerator parameter k=v (repeatable)");
+       app.add_option("-o,--output", a->output, "output .png file")->required();
+       return [a] { return run_render(*a); };
+     }}};
 
 }  // namespace
 }  // namespace ab

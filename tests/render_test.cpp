@@ -1,17 +1,17 @@
 // Rendering: the same image for any thread count and any structure, not blank, close to a committed
 // low-resolution reference; heatmaps and PNG files.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
 #include "accel/registry.h"
 #include "tracer/heatmap.h"
 #include "tracer/image.h"
 #include "tracer/integrator.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"
-
-#include <gtest/gtest.h>
-
-#include <cmath>
-#include <cstdlib>
-#include <filesystem>
 
 namespace ab {
 namespace {

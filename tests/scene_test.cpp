@@ -1,23 +1,24 @@
 // Scenes: parsing, errors with line numbers, instancing (each base mesh built once), instanced hits
 // against the flattened mesh, byte-identical hits across every structure at both levels, Embree's
 // instances, flatten and the CLI's answers to bad scenes.
-#include "accel/embree_scene.h"
-#include "accel/error.h"
-#include "accel/registry.h"
-#include "accel/trace.h"
-#include "tracer/sampling.h"
 #include "tracer/scene.h"
-#include "tracer/scene_accel.h"
-#include "tracer/workload.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <sys/wait.h>
+
+#include "accel/embree_scene.h"
+#include "accel/error.h"
+#include "accel/registry.h"
+#include "accel/trace.h"
+#include "tracer/sampling.h"
+#include "tracer/scene_accel.h"
+#include "tracer/workload.h"
 
 namespace ab {
 namespace {
@@ -34,17 +35,18 @@ std::string instanced_scene_xml(int count) {
      << "<material name='g' type='glossy'><roughness>0.2</roughness></material>\n"
      << "<mesh name='flake' generator='sphereflake' triangles='300' seed='3'/>\n"
      << "<mesh name='tetra' generator='tetra' triangles='256' seed='1'/>\n"
-     << "<mesh name='quad'><vertices>-1 0 -1 1 0 -1 1 0 1 -1 0 1</vertices><triangles>0 2 1 0 3 2</triangles></mesh>\n";
+     << "<mesh name='quad'><vertices>-1 0 -1 1 0 -1 1 0 1 -1 0 1</vertices><triangles>0 2 1 0 3 "
+        "2</triangles></mesh>\n";
   Rng rng(7, 0);
   for (int i = 0; i < count; ++i) {
     const char* mesh = i % 7 == 6 ? "quad" : (i % 2 ? "tetra" : "flake");
     os << "<instance mesh='" << mesh << "'" << (i % 3 == 0 ? " material='g'" : "") << ">"
        << "<translate>" << (i % 15) * 1.6f - 11.0f + rng.uniform() << " " << (i / 15 % 4) * 1.5f - 3.0f << " "
        << (i / 60) * 1.7f - 4.0f + rng.uniform() << "</translate>"
-       << "<rotate axis='" << rng.uniform() - 0.5f << " " << rng.uniform() << " " << rng.uniform() - 0.5f << "'>"
-       << rng.uniform() * 360.0f << "</rotate>"
-       << "<scale>" << 0.4f + rng.uniform() << " " << 0.3f + 0.5f * rng.uniform() << " " << 0.5f + rng.uniform()
-       << "</scale></instance>\n";
+       << "<rotate axis='" << rng.uniform() - 0.5f << " " << rng.uniform() << " " << rng.uniform() - 0.5f
+       << "'>" << rng.uniform() * 360.0f << "</rotate>"
+       << "<scale>" << 0.4f + rng.uniform() << " " << 0.3f + 0.5f * rng.uniform() << " "
+       << 0.5f + rng.uniform() << "</scale></instance>\n";
   }
   os << "</scene>\n";
   return os.str();
@@ -84,7 +86,8 @@ void expect_error(const std::string& xml, int line, const std::string& words) {
   }
 }
 
-const char* kQuad = "<mesh name='q'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles></mesh>\n";
+const char* kQuad =
+    "<mesh name='q'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles></mesh>\n";
 
 TEST(Scene, ParsesEverything) {
   const Scene& s = *instanced_scene(30);
@@ -105,29 +108,38 @@ TEST(Scene, ParsesEverything) {
 
 TEST(Scene, ErrorsNameTheFileAndLine) {
   expect_error("<scene>\n<instance mesh='q'/>\n<oops>\n</scene>", 4, "malformed XML");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='nope'/>\n</scene>", 3, "unknown mesh 'nope'");
+  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='nope'/>\n</scene>", 3,
+               "unknown mesh 'nope'");
   expect_error(std::string("<scene>\n") + kQuad + "\n<instance mesh='q' material='m'/></scene>", 4,
                "unknown material 'm'");
   expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q' transform='t'/></scene>", 3,
                "unknown transform 't'");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<translate>1 2 x</translate></instance></scene>",
+  expect_error(std::string("<scene>\n") + kQuad +
+                   "<instance mesh='q'>\n<translate>1 2 x</translate></instance></scene>",
                4, "bad number 'x'");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<translate>1 2</translate></instance></scene>",
-               4, "needs 3 numbers");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<scale>1 nan 1</scale></instance></scene>", 4,
-               "bad number 'nan'");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n<camera><fov>500</fov></camera></scene>", 4,
-               "fov");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n\n<lamp/></scene>", 5, "unknown element <lamp>");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n<material name='m' type='velvet'/></scene>", 4,
-               "velvet");
-  expect_error("<scene>\n<mesh name='q'><vertices>0 0 0</vertices>\n<triangles>0 1 2</triangles></mesh></scene>", 3,
-               "out of range");
+  expect_error(
+      std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<translate>1 2</translate></instance></scene>",
+      4, "needs 3 numbers");
+  expect_error(
+      std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<scale>1 nan 1</scale></instance></scene>", 4,
+      "bad number 'nan'");
+  expect_error(
+      std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n<camera><fov>500</fov></camera></scene>", 4,
+      "fov");
+  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n\n<lamp/></scene>", 5,
+               "unknown element <lamp>");
+  expect_error(
+      std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n<material name='m' type='velvet'/></scene>",
+      4, "velvet");
+  expect_error(
+      "<scene>\n<mesh name='q'><vertices>0 0 0</vertices>\n<triangles>0 1 2</triangles></mesh></scene>", 3,
+      "out of range");
   expect_error("<scene>\n<mesh name='g' generator='no-such-generator'/>\n</scene>", 2, "no-such-generator");
   expect_error("<scene>\n<mesh name='f' file='missing.obj'/>\n</scene>", 2, "missing.obj");
   expect_error(std::string("<scene>\n") + kQuad + kQuad + "</scene>", 3, "declared twice");
   expect_error(std::string("<scene>\n") + kQuad + "</scene>", 1, "no <instance>");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<rotate axis='W'>3</rotate></instance></scene>",
+  expect_error(std::string("<scene>\n") + kQuad +
+                   "<instance mesh='q'>\n<rotate axis='W'>3</rotate></instance></scene>",
                4, "axis");
 }
 
@@ -150,8 +162,13 @@ TEST(Scene, InstancedHitsMatchTheFlattenedMesh) {
   for (size_t i = 0; i < scene->instances.size(); ++i)
     first[i + 1] = first[i] + uint32_t(scene->meshes[scene->instances[i].mesh].mesh->size());
   const std::string fast = "bvh-sah";
-  const bool have_bvh = [&] { for (const auto& a : accelerators()) if (a.name == fast) return true; return false; }();
-  auto world = make_accelerator(have_bvh ? fast : "brute", std::make_shared<TrianglePrims>(std::make_shared<Mesh>(flat)), {});
+  const bool have_bvh = [&] {
+    for (const auto& a : accelerators())
+      if (a.name == fast) return true;
+    return false;
+  }();
+  auto world = make_accelerator(have_bvh ? fast : "brute",
+                                std::make_shared<TrianglePrims>(std::make_shared<Mesh>(flat)), {});
   world->build();
   auto inst = make_scene_accelerator(scene, have_bvh ? fast : "brute", Params{});
   inst->build();
@@ -161,7 +178,10 @@ TEST(Scene, InstancedHitsMatchTheFlattenedMesh) {
   inst->intersect(rays, b);
   size_t hits = 0, same = 0, found_differs = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
-    if (a[i].found() != b[i].found()) { ++found_differs; continue; }
+    if (a[i].found() != b[i].found()) {
+      ++found_differs;
+      continue;
+    }
     if (!a[i].found()) continue;
     ++hits;
     EXPECT_NEAR(a[i].t, b[i].t, 1e-4f * std::max(1.0f, a[i].t)) << "ray " << i;
@@ -190,8 +210,9 @@ TEST(Scene, EveryStructureGivesByteIdenticalHitsAtBothLevels) {
   int tested = 0;
   for (const AcceleratorInfo& info : accelerators()) {
     if (!info.make_for_instances || info.name.rfind("test-", 0) == 0) continue;
-    for (const auto& [top, bottom] : {std::pair{info.name, info.name}, std::pair{info.name, std::string("brute")},
-                                      std::pair{std::string("brute"), info.name}}) {
+    for (const auto& [top, bottom] :
+         {std::pair{info.name, info.name}, std::pair{info.name, std::string("brute")},
+          std::pair{std::string("brute"), info.name}}) {
       auto accel = make_scene_accelerator(scene, top, Params{}, top, bottom);
       accel->build();
       for (int threads : {1, 2}) {
@@ -251,7 +272,11 @@ TEST(Scene, LevelParametersAreRoutedAndChecked) {
 
 TEST(Scene, WorkloadsAreExactAndDeterministic) {
   auto scene = instanced_scene(60);
-  const bool have_bvh = [&] { for (const auto& a : accelerators()) if (a.name == "bvh-sah") return true; return false; }();
+  const bool have_bvh = [&] {
+    for (const auto& a : accelerators())
+      if (a.name == "bvh-sah") return true;
+    return false;
+  }();
   auto accel = make_scene_accelerator(scene, have_bvh ? "bvh-sah" : "brute", Params{});
   accel->build();
   const TraceFn trace = [&](std::span<const Ray> r, std::span<Hit> h) { accel->intersect(r, h); };
@@ -341,10 +366,12 @@ TEST(Scene, CliRejectsBadScenesWithOneLine) {
   const fs::path dir = fs::temp_directory_path() / ("accelbench_scene_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path bad = dir / "bad.xml";
-  std::ofstream(bad) << "<scene>\n" << kQuad << "<instance mesh='q'>\n<scale>1 x 1</scale></instance>\n</scene>\n";
-  for (const std::string& cmd : {"render --scene " + bad.string() + " -o " + (dir / "o.png").string(),
-                                "flatten --scene " + bad.string() + " -o " + (dir / "o.obj").string(),
-                                "rays --scene " + bad.string() + " --kind primary --count 5 -o " + (dir / "o.rays").string()}) {
+  std::ofstream(bad) << "<scene>\n"
+                     << kQuad << "<instance mesh='q'>\n<scale>1 x 1</scale></instance>\n</scene>\n";
+  for (const std::string& cmd :
+       {"render --scene " + bad.string() + " -o " + (dir / "o.png").string(),
+        "flatten --scene " + bad.string() + " -o " + (dir / "o.obj").string(),
+        "rays --scene " + bad.string() + " --kind primary --count 5 -o " + (dir / "o.rays").string()}) {
     const auto [code, err] = run_cli(cmd, dir);
     EXPECT_EQ(code, 2) << cmd << ": " << err;
     EXPECT_NE(err.find("bad.xml:4:"), std::string::npos) << err;
@@ -366,7 +393,10 @@ TEST(Scene, CliFlattenAndRaysWork) {
   EXPECT_TRUE(fs::exists(dir / "f.obj"));
   for (const char* kind : {"primary", "dof", "shadow", "glossy", "diffuse"}) {
     const fs::path out = dir / (std::string(kind) + ".rays");
-    EXPECT_EQ(run_cli("rays --scene " + scene.string() + " --kind " + kind + " --count 100 -o " + out.string(), dir).first, 0);
+    EXPECT_EQ(
+        run_cli("rays --scene " + scene.string() + " --kind " + kind + " --count 100 -o " + out.string(), dir)
+            .first,
+        0);
     EXPECT_EQ(fs::file_size(out), 16u + 100u * 32u) << kind;
   }
   fs::remove_all(dir);

@@ -1,12 +1,13 @@
 // Transform composition order and inverse-transpose normals, on hand-computed cases.
-#include "accel/error.h"
-#include "tracer/scene.h"
 #include "tracer/transform.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
+
+#include "accel/error.h"
+#include "tracer/scene.h"
 
 namespace ab {
 namespace {
@@ -19,8 +20,10 @@ void expect_near(const vec3& a, const vec3& b, float tol = 1e-6f) {
 
 /// The transform of the only instance of a scene whose instance body is `ops`.
 Transform parse_transform(const std::string& ops) {
-  const std::string xml = "<scene><mesh name='m'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles>"
-                          "</mesh><transform name='x'>" + ops + "</transform><instance mesh='m' transform='x'/></scene>";
+  const std::string xml =
+      "<scene><mesh name='m'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles>"
+      "</mesh><transform name='x'>" +
+      ops + "</transform><instance mesh='m' transform='x'/></scene>";
   return parse_scene(xml, "t.xml", ".").instances.at(0).transform;
 }
 
@@ -42,8 +45,8 @@ TEST(Transform, ArbitraryAnglesAndAxes) {
 
 TEST(Transform, ElementsComposeInDocumentOrderOnTheFrame) {
   // M = T(1,2,3) * Ry(90) * S(2): (1,0,0) -> scale (2,0,0) -> rotate (0,0,-2) -> translate (1,2,1).
-  const Transform x = parse_transform(
-      "<translate>1 2 3</translate><rotate axis='Y'>90</rotate><scale>2 2 2</scale>");
+  const Transform x =
+      parse_transform("<translate>1 2 3</translate><rotate axis='Y'>90</rotate><scale>2 2 2</scale>");
   expect_near(x.point({1, 0, 0}), {1, 2, 1}, 0);
   expect_near(x.point({0, 0, 0}), {1, 2, 3}, 0);
   // The reverse order: M = S(2) * T(1,0,0): the origin goes to (2,0,0).
@@ -53,8 +56,8 @@ TEST(Transform, ElementsComposeInDocumentOrderOnTheFrame) {
   const Transform z = parse_transform(
       "<translate>12 13 14</translate><rotate axis='X'>90</rotate><rotate axis='Y'>120</rotate>"
       "<rotate axis='Z'>10</rotate><scale>2 2 2</scale>");
-  const glm::mat4 m = translate_matrix({12, 13, 14}) * rotate_matrix({1, 0, 0}, 90) * rotate_matrix({0, 1, 0}, 120) *
-                      rotate_matrix({0, 0, 1}, 10) * scale_matrix(vec3(2));
+  const glm::mat4 m = translate_matrix({12, 13, 14}) * rotate_matrix({1, 0, 0}, 90) *
+                      rotate_matrix({0, 1, 0}, 120) * rotate_matrix({0, 0, 1}, 10) * scale_matrix(vec3(2));
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r) EXPECT_FLOAT_EQ(z.to_world[c][r], m[c][r]);
   // Hand-computed: (1,0,0) -> S (2,0,0) -> Rz10 (2cos10, 2sin10, 0) -> Ry120 -> Rx90 -> +T.
@@ -71,7 +74,8 @@ TEST(Transform, InlineElementsFollowTheNamedTransform) {
       "<scene><mesh name='m'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles></mesh>"
       "<transform name='up'><translate>0 5 0</translate></transform>"
       "<instance mesh='m' transform='up'><scale>3</scale></instance>"
-      "<instance mesh='m'><transform><rotate axis='Z'>90</rotate></transform><translate>1 0 0</translate></instance>"
+      "<instance mesh='m'><transform><rotate axis='Z'>90</rotate></transform><translate>1 0 "
+      "0</translate></instance>"
       "</scene>";
   const Scene s = parse_scene(xml, "t.xml", ".");
   expect_near(s.instances[0].transform.point({1, 0, 0}), {3, 5, 0}, 0);
@@ -100,7 +104,8 @@ TEST(Transform, NormalsGoByTheInverseTranspose) {
 }
 
 TEST(Transform, InverseUndoesTheTransform) {
-  const Transform x = parse_transform("<translate>1 -2 3</translate><rotate axis='1 2 3'>37</rotate><scale>0.5 4 2</scale>");
+  const Transform x =
+      parse_transform("<translate>1 -2 3</translate><rotate axis='1 2 3'>37</rotate><scale>0.5 4 2</scale>");
   const vec3 p(0.3f, -1.2f, 2.5f);
   expect_near(vec3(x.to_object * glm::vec4(x.point(p), 1.0f)), p, 1e-5f);
 }

@@ -1,8 +1,8 @@
 #include "tracer/camera.h"
 
-#include "tracer/sampling.h"
-
 #include <cmath>
+
+#include "tracer/sampling.h"
 
 namespace ab {
 

@@ -2,9 +2,9 @@
 // distributing rays over the lens). With aperture 0 it is a pinhole camera.
 #pragma once
 
-#include "accel/geometry.h"
-
 #include <glm/glm.hpp>
+
+#include "accel/geometry.h"
 
 namespace ab {
 
@@ -13,9 +13,9 @@ struct Camera {
   vec3 eye{0.0f, 0.0f, 5.0f};
   vec3 look_at{0.0f};
   vec3 up{0.0f, 1.0f, 0.0f};
-  float fov_degrees = 45.0f;   ///< vertical field of view
-  float aperture = 0.0f;       ///< lens radius in world units (0: pinhole)
-  float focal_distance = 0.0f; ///< distance to the plane in focus (0: distance from eye to look_at)
+  float fov_degrees = 45.0f;    ///< vertical field of view
+  float aperture = 0.0f;        ///< lens radius in world units (0: pinhole)
+  float focal_distance = 0.0f;  ///< distance to the plane in focus (0: distance from eye to look_at)
 };
 
 /// The camera prepared for an image of a given aspect: generates primary rays.

@@ -16,7 +16,8 @@ void viridis(float t, uint8_t rgb[3]) {
   const int i = std::min(7, static_cast<int>(t));
   const float f = t - float(i);
   for (int k = 0; k < 3; ++k)
-    rgb[k] = static_cast<uint8_t>(std::lround(float(kStops[i][k]) * (1.0f - f) + float(kStops[i + 1][k]) * f));
+    rgb[k] =
+        static_cast<uint8_t>(std::lround(float(kStops[i][k]) * (1.0f - f) + float(kStops[i + 1][k]) * f));
 }
 
 namespace {
@@ -24,7 +25,8 @@ namespace {
 /// Draws text with stb_easy_font (quads of one colour) at (x, y), scaled by an integer factor.
 void draw_text(Image8& img, int x, int y, const std::string& text, int scale, uint8_t grey) {
   static char buffer[60000];
-  const int quads = stb_easy_font_print(0.0f, 0.0f, const_cast<char*>(text.c_str()), nullptr, buffer, sizeof buffer);
+  const int quads =
+      stb_easy_font_print(0.0f, 0.0f, const_cast<char*>(text.c_str()), nullptr, buffer, sizeof buffer);
   const auto* v = reinterpret_cast<const float*>(buffer);
   for (int q = 0; q < quads; ++q) {
     const float* p = v + q * 16;  // 4 vertices of (x, y, z, colour) = 4 floats each
@@ -52,7 +54,8 @@ Image8 heatmap_image(const std::vector<float>& values, int width, int height, co
   const int scale = width >= 384 ? 2 : 1;
   const int bar_h = 10 * scale, text_h = 24 * scale, margin = 4 * scale;
   Image8 img(width, height + margin + bar_h + text_h + margin);
-  std::fill(img.rgb.begin() + std::ptrdiff_t(size_t(width) * size_t(height) * 3), img.rgb.end(), uint8_t(255));
+  std::fill(img.rgb.begin() + std::ptrdiff_t(size_t(width) * size_t(height) * 3), img.rgb.end(),
+            uint8_t(255));
   float vmax = 0.0f;
   for (float v : values) vmax = std::max(vmax, v);
   if (scale_max > 0.0f) vmax = scale_max;

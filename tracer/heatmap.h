@@ -2,10 +2,10 @@
 // compared by eye.
 #pragma once
 
-#include "tracer/image.h"
-
 #include <string>
 #include <vector>
+
+#include "tracer/image.h"
 
 namespace ab {
 

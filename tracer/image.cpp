@@ -1,10 +1,10 @@
 #include "tracer/image.h"
 
-#include "accel/error.h"
-#include "datasets/atomic_file.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "accel/error.h"
+#include "datasets/atomic_file.h"
 
 // The one definition of stb_image_write and stb_image in the project.
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -51,7 +51,8 @@ void write_png(const Image8& image, const std::string& path) {
   if (!stbi_write_png_to_func(append_bytes, &bytes, image.width, image.height, 3, image.rgb.data(),
                               image.width * 3))
     throw InputError(path + ": cannot encode PNG");
-  write_file_atomically(path, [&](std::ostream& os) { os.write(bytes.data(), std::streamsize(bytes.size())); });
+  write_file_atomically(path,
+                        [&](std::ostream& os) { os.write(bytes.data(), std::streamsize(bytes.size())); });
 }
 
 Image8 read_png(const std::string& path) {

@@ -1,11 +1,11 @@
 // Images: linear RGB radiance from the integrator, 8-bit sRGB for files, PNG I/O (stb).
 #pragma once
 
-#include "accel/geometry.h"
-
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "accel/geometry.h"
 
 namespace ab {
 

@@ -1,9 +1,5 @@
 #include "tracer/integrator.h"
 
-#include "tracer/camera.h"
-#include "tracer/sampling.h"
-#include "tracer/workload.h"
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -11,6 +7,10 @@
 #include <cmath>
 #include <mutex>
 #include <numbers>
+
+#include "tracer/camera.h"
+#include "tracer/sampling.h"
+#include "tracer/workload.h"
 
 namespace ab {
 
@@ -245,7 +245,8 @@ std::vector<float> render_work(const Scene& scene, const Accelerator& accel, con
       const glm::vec2 px = s.next2();
       const glm::vec2 lens = s.next2();
       Hit hit;
-      accel.intersect_one(camera.generate(float(x) + px.x, float(y) + px.y, lens.x, lens.y), hit, kInvalidId, &c);
+      accel.intersect_one(camera.generate(float(x) + px.x, float(y) + px.y, lens.x, lens.y), hit, kInvalidId,
+                          &c);
     }
     const uint64_t v = metric == HeatmapMetric::kNodes ? c.nodes : c.prims;
     work[size_t(y) * size_t(opt.width) + size_t(x)] = float(double(v) / double(opt.spp));

@@ -3,15 +3,15 @@
 // glossy reflection; mirror reflection and dielectric refraction (Snell's law, Fresnel); a recursion limit.
 #pragma once
 
-#include "accel/accelerator.h"
-#include "tracer/image.h"
-#include "tracer/scene.h"
-
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "accel/accelerator.h"
+#include "tracer/image.h"
+#include "tracer/scene.h"
 
 namespace ab {
 

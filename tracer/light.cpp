@@ -4,7 +4,9 @@
 
 namespace ab {
 
-vec3 AreaLight::normal_area() const { return glm::cross(edge1, edge2); }
+vec3 AreaLight::normal_area() const {
+  return glm::cross(edge1, edge2);
+}
 
 float AreaLight::intersect(const Ray& ray) const {
   const vec3 n = normal_area();

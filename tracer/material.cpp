@@ -12,10 +12,14 @@ float Material::phong_exponent() const {
 
 const char* material_type_name(Material::Type t) {
   switch (t) {
-    case Material::Type::kDiffuse: return "diffuse";
-    case Material::Type::kMirror: return "mirror";
-    case Material::Type::kGlossy: return "glossy";
-    case Material::Type::kDielectric: return "dielectric";
+    case Material::Type::kDiffuse:
+      return "diffuse";
+    case Material::Type::kMirror:
+      return "mirror";
+    case Material::Type::kGlossy:
+      return "glossy";
+    case Material::Type::kDielectric:
+      return "dielectric";
   }
   return "diffuse";
 }

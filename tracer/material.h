@@ -2,9 +2,9 @@
 // Cook 1984) and dielectric (Snell refraction with Fresnel reflection).
 #pragma once
 
-#include "accel/geometry.h"
-
 #include <string>
+
+#include "accel/geometry.h"
 
 namespace ab {
 

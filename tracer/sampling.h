@@ -2,12 +2,11 @@
 // (image seed, pixel index), so an image does not depend on how pixels are spread over threads.
 #pragma once
 
-#include "accel/geometry.h"
-
-#include <glm/glm.hpp>
-
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <vector>
+
+#include "accel/geometry.h"
 
 namespace ab {
 

@@ -1,12 +1,5 @@
 #include "tracer/scene.h"
 
-#include "accel/error.h"
-#include "accel/params.h"
-#include "datasets/generators.h"
-#include "datasets/mesh_io.h"
-
-#include <pugixml.hpp>
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -14,8 +7,14 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <pugixml.hpp>
 #include <set>
 #include <sstream>
+
+#include "accel/error.h"
+#include "accel/params.h"
+#include "datasets/generators.h"
+#include "datasets/mesh_io.h"
 
 namespace ab {
 
@@ -33,8 +32,8 @@ class SceneParser {
     const pugi::xml_parse_result res = doc.load_buffer(text_.data(), text_.size(), pugi::parse_default);
     if (!res) fail_at(res.offset, std::string("malformed XML: ") + res.description());
     const pugi::xml_node root = doc.document_element();
-    if (std::string(root.name()) != "scene") fail(root, "the root element must be <scene>, not <" +
-                                                      std::string(root.name()) + ">");
+    if (std::string(root.name()) != "scene")
+      fail(root, "the root element must be <scene>, not <" + std::string(root.name()) + ">");
     check_attributes(root, {});
     scene_.path = path_;
     Material fallback;
@@ -54,7 +53,9 @@ class SceneParser {
     const auto line = 1 + std::count(text_.begin(), text_.begin() + static_cast<ptrdiff_t>(end), '\n');
     throw InputError(path_ + ":" + std::to_string(line) + ": " + msg);
   }
-  [[noreturn]] void fail(const pugi::xml_node& n, const std::string& msg) const { fail_at(n.offset_debug(), msg); }
+  [[noreturn]] void fail(const pugi::xml_node& n, const std::string& msg) const {
+    fail_at(n.offset_debug(), msg);
+  }
 
   void check_attributes(const pugi::xml_node& n, const std::set<std::string>& allowed) const {
     for (pugi::xml_attribute a : n.attributes())
@@ -63,7 +64,8 @@ class SceneParser {
   }
   std::string required_attribute(const pugi::xml_node& n, const char* name) const {
     const pugi::xml_attribute a = n.attribute(name);
-    if (!a || std::string(a.value()).empty()) fail(n, "<" + std::string(n.name()) + "> needs attribute '" + name + "'");
+    if (!a || std::string(a.value()).empty())
+      fail(n, "<" + std::string(n.name()) + "> needs attribute '" + name + "'");
     return a.value();
   }
 
@@ -106,15 +108,16 @@ class SceneParser {
     if (v != std::floor(v)) fail(n, "<" + std::string(n.name()) + "> must be an integer");
     return static_cast<int>(v);
   }
-  uint64_t attribute_integer(const pugi::xml_node& n, const char* name, uint64_t def, uint64_t lo, uint64_t hi) const {
+  uint64_t attribute_integer(const pugi::xml_node& n, const char* name, uint64_t def, uint64_t lo,
+                             uint64_t hi) const {
     const pugi::xml_attribute a = n.attribute(name);
     if (!a) return def;
     const std::string s = a.value();
     uint64_t v = 0;
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     if (ec != std::errc() || ptr != s.data() + s.size() || s.empty() || v < lo || v > hi)
-      fail(n, "attribute " + std::string(name) + "=\"" + s + "\" must be an integer in [" + std::to_string(lo) +
-                  ", " + std::to_string(hi) + "]");
+      fail(n, "attribute " + std::string(name) + "=\"" + s + "\" must be an integer in [" +
+                  std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v;
   }
   static std::string fmt(float v) {
@@ -126,7 +129,8 @@ class SceneParser {
   // ---- declarations ----
   void declaration(const pugi::xml_node& n) {
     if (n.type() != pugi::node_element) {
-      if (n.type() == pugi::node_pcdata && std::string(n.value()).find_first_not_of(" \t\r\n") != std::string::npos)
+      if (n.type() == pugi::node_pcdata &&
+          std::string(n.value()).find_first_not_of(" \t\r\n") != std::string::npos)
         fail(n, "unexpected text in <scene>");
       return;
     }
@@ -156,7 +160,8 @@ class SceneParser {
     std::set<std::string> seen;
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
-      if (!allowed.count(c.name())) fail(c, "unknown element <" + std::string(c.name()) + "> in <" + n.name() + ">");
+      if (!allowed.count(c.name()))
+        fail(c, "unknown element <" + std::string(c.name()) + "> in <" + n.name() + ">");
       if (!seen.insert(c.name()).second && std::string(c.name()) != "param")
         fail(c, "<" + std::string(c.name()) + "> given twice in <" + n.name() + ">");
       f(c, std::string(c.name()));
@@ -166,14 +171,15 @@ class SceneParser {
   void camera(const pugi::xml_node& n) {
     check_attributes(n, {});
     Camera& cam = scene_.camera;
-    children(n, {"eye", "lookat", "up", "fov", "aperture", "focus"}, [&](const pugi::xml_node& c, const std::string& k) {
-      if (k == "eye") cam.eye = vector3(c);
-      if (k == "lookat") cam.look_at = vector3(c);
-      if (k == "up") cam.up = vector3(c);
-      if (k == "fov") cam.fov_degrees = number_in(c, 1.0f, 179.0f);
-      if (k == "aperture") cam.aperture = number_in(c, 0.0f, std::numeric_limits<float>::max());
-      if (k == "focus") cam.focal_distance = number_in(c, 0.0f, std::numeric_limits<float>::max());
-    });
+    children(n, {"eye", "lookat", "up", "fov", "aperture", "focus"},
+             [&](const pugi::xml_node& c, const std::string& k) {
+               if (k == "eye") cam.eye = vector3(c);
+               if (k == "lookat") cam.look_at = vector3(c);
+               if (k == "up") cam.up = vector3(c);
+               if (k == "fov") cam.fov_degrees = number_in(c, 1.0f, 179.0f);
+               if (k == "aperture") cam.aperture = number_in(c, 0.0f, std::numeric_limits<float>::max());
+               if (k == "focus") cam.focal_distance = number_in(c, 0.0f, std::numeric_limits<float>::max());
+             });
     const vec3 f = cam.look_at - cam.eye;
     if (glm::length(f) == 0.0f) fail(n, "camera eye and lookat coincide");
     if (glm::length(glm::cross(f, cam.up)) <= 1e-6f * glm::length(f) * glm::length(cam.up))
@@ -183,13 +189,14 @@ class SceneParser {
   void render(const pugi::xml_node& n) {
     check_attributes(n, {});
     RenderSettings& r = scene_.render;
-    children(n, {"width", "height", "spp", "maxdepth", "diffusedepth"}, [&](const pugi::xml_node& c, const std::string& k) {
-      if (k == "width") r.width = integer_in(c, 1, 16384);
-      if (k == "height") r.height = integer_in(c, 1, 16384);
-      if (k == "spp") r.spp = integer_in(c, 1, 65536);
-      if (k == "maxdepth") r.max_depth = integer_in(c, 1, 64);
-      if (k == "diffusedepth") r.diffuse_depth = integer_in(c, 0, 64);
-    });
+    children(n, {"width", "height", "spp", "maxdepth", "diffusedepth"},
+             [&](const pugi::xml_node& c, const std::string& k) {
+               if (k == "width") r.width = integer_in(c, 1, 16384);
+               if (k == "height") r.height = integer_in(c, 1, 16384);
+               if (k == "spp") r.spp = integer_in(c, 1, 65536);
+               if (k == "maxdepth") r.max_depth = integer_in(c, 1, 64);
+               if (k == "diffusedepth") r.diffuse_depth = integer_in(c, 0, 64);
+             });
   }
 
   void material(const pugi::xml_node& n) {
@@ -197,18 +204,24 @@ class SceneParser {
     Material m;
     m.name = required_attribute(n, "name");
     const std::string type = required_attribute(n, "type");
-    if (type == "diffuse") m.type = Material::Type::kDiffuse;
-    else if (type == "mirror") m.type = Material::Type::kMirror;
-    else if (type == "glossy") m.type = Material::Type::kGlossy;
-    else if (type == "dielectric") m.type = Material::Type::kDielectric;
-    else fail(n, "unknown material type '" + type + "' (known: diffuse, mirror, glossy, dielectric)");
+    if (type == "diffuse")
+      m.type = Material::Type::kDiffuse;
+    else if (type == "mirror")
+      m.type = Material::Type::kMirror;
+    else if (type == "glossy")
+      m.type = Material::Type::kGlossy;
+    else if (type == "dielectric")
+      m.type = Material::Type::kDielectric;
+    else
+      fail(n, "unknown material type '" + type + "' (known: diffuse, mirror, glossy, dielectric)");
     if (m.type != Material::Type::kDiffuse) m.color = vec3(1.0f);
     children(n, {"color", "roughness", "ior"}, [&](const pugi::xml_node& c, const std::string& k) {
       if (k == "color") m.color = nonnegative3(c);
       if (k == "roughness") m.roughness = number_in(c, 0.0f, 1.0f);
       if (k == "ior") m.ior = number_in(c, 1.0f, 10.0f);
     });
-    if (material_index_.count(m.name) && m.name != "default") fail(n, "material '" + m.name + "' declared twice");
+    if (material_index_.count(m.name) && m.name != "default")
+      fail(n, "material '" + m.name + "' declared twice");
     if (m.name == "default") {
       if (default_replaced_) fail(n, "material 'default' declared twice");
       default_replaced_ = true;
@@ -231,15 +244,17 @@ class SceneParser {
       scene_.point_lights.push_back(l);
     } else if (type == "area") {
       AreaLight l;
-      children(n, {"corner", "edge1", "edge2", "radiance"}, [&](const pugi::xml_node& c, const std::string& k) {
-        if (k == "corner") l.corner = vector3(c);
-        if (k == "edge1") l.edge1 = vector3(c);
-        if (k == "edge2") l.edge2 = vector3(c);
-        if (k == "radiance") l.radiance = nonnegative3(c);
-      });
+      children(n, {"corner", "edge1", "edge2", "radiance"},
+               [&](const pugi::xml_node& c, const std::string& k) {
+                 if (k == "corner") l.corner = vector3(c);
+                 if (k == "edge1") l.edge1 = vector3(c);
+                 if (k == "edge2") l.edge2 = vector3(c);
+                 if (k == "radiance") l.radiance = nonnegative3(c);
+               });
       const float a = glm::length(l.edge1), b = glm::length(l.edge2);
       if (a == 0.0f || b == 0.0f) fail(n, "area light edges must be non-zero");
-      if (std::fabs(glm::dot(l.edge1, l.edge2)) > 1e-4f * a * b) fail(n, "area light edges must be perpendicular");
+      if (std::fabs(glm::dot(l.edge1, l.edge2)) > 1e-4f * a * b)
+        fail(n, "area light edges must be perpendicular");
       scene_.area_lights.push_back(l);
     } else {
       fail(n, "unknown light type '" + type + "' (known: point, area)");
@@ -334,7 +349,8 @@ class SceneParser {
     } else if (k == "scale") {
       check_attributes(c, {});
       const std::vector<float> v = numbers(c, 0);
-      if (v.size() != 1 && v.size() != 3) fail(c, "<scale> needs 1 or 3 numbers, got " + std::to_string(v.size()));
+      if (v.size() != 1 && v.size() != 3)
+        fail(c, "<scale> needs 1 or 3 numbers, got " + std::to_string(v.size()));
       x.then(scale_matrix(v.size() == 1 ? vec3(v[0]) : vec3(v[0], v[1], v[2])));
     } else if (k == "rotate") {
       check_attributes(c, {"axis"});
@@ -355,7 +371,8 @@ class SceneParser {
   /// `nested` is true) contributes its own elements at its place.
   void transform_elements(const pugi::xml_node& n, Transform& x, bool nested) const {
     for (pugi::xml_node c : n.children()) {
-      if (c.type() == pugi::node_pcdata && std::string(c.value()).find_first_not_of(" \t\r\n") != std::string::npos)
+      if (c.type() == pugi::node_pcdata &&
+          std::string(c.value()).find_first_not_of(" \t\r\n") != std::string::npos)
         fail(c, "unexpected text in <" + std::string(n.name()) + ">");
       if (c.type() != pugi::node_element) continue;
       if (nested && std::string(c.name()) == "transform") {
@@ -375,7 +392,8 @@ class SceneParser {
     std::istringstream is(a);
     vec3 v;
     std::string rest;
-    if (!(is >> v.x >> v.y >> v.z) || (is >> rest) || !std::isfinite(glm::dot(v, v)) || glm::dot(v, v) == 0.0f)
+    if (!(is >> v.x >> v.y >> v.z) || (is >> rest) || !std::isfinite(glm::dot(v, v)) ||
+        glm::dot(v, v) == 0.0f)
       fail(c, "rotate axis '" + a + "' must be X, Y, Z or three numbers (not all zero)");
     return v;
   }

@@ -2,15 +2,15 @@
 // camera, read from the XML format described in docs/scenes.md.
 #pragma once
 
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "accel/mesh.h"
 #include "tracer/camera.h"
 #include "tracer/light.h"
 #include "tracer/material.h"
 #include "tracer/transform.h"
-
-#include <memory>
-#include <string>
-#include <vector>
 
 namespace ab {
 

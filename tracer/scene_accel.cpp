@@ -1,17 +1,19 @@
 #include "tracer/scene_accel.h"
 
+#include <algorithm>
+
 #include "accel/embree_scene.h"
 #include "accel/registry.h"
-
-#include <algorithm>
 
 namespace ab {
 
 Params level_params(const Params& params, const std::string& prefix, const std::string& other) {
   Params out;
   for (const auto& [k, v] : params.values()) {
-    if (k.rfind(prefix + ".", 0) == 0) out.set(k.substr(prefix.size() + 1), v);
-    else if (k.rfind(other + ".", 0) != 0) out.set(k, v);
+    if (k.rfind(prefix + ".", 0) == 0)
+      out.set(k.substr(prefix.size() + 1), v);
+    else if (k.rfind(other + ".", 0) != 0)
+      out.set(k, v);
   }
   return out;
 }
@@ -24,7 +26,8 @@ SceneAccelerator::SceneAccelerator(std::shared_ptr<const Scene> scene, std::stri
       top_params_(level_params(params, "top", "bottom")),
       bottom_params_(level_params(params, "bottom", "top")) {
   for (const SceneMesh& m : scene_->meshes)
-    bottoms_.push_back(make_accelerator(bottom_name_, std::make_shared<TrianglePrims>(m.mesh), bottom_params_));
+    bottoms_.push_back(
+        make_accelerator(bottom_name_, std::make_shared<TrianglePrims>(m.mesh), bottom_params_));
   // Checks the top-level name and parameters now (the real top is made once the bottoms are built).
   make_instance_accelerator(top_name_, std::make_shared<InstancePrims>(std::vector<Instance>{}), top_params_);
   bounds_ = scene_->world_bounds();
@@ -95,9 +98,9 @@ void SceneAccelerator::aggregate_stats() {
   stats_.build_seconds = seconds;
 }
 
-std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene> scene, const std::string& name,
-                                                    const Params& params, const std::string& top,
-                                                    const std::string& bottom) {
+std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene> scene,
+                                                    const std::string& name, const Params& params,
+                                                    const std::string& top, const std::string& bottom) {
   const std::string t = top.empty() ? name : top;
   const std::string b = bottom.empty() ? name : bottom;
   if (t == kEmbreeName && b == kEmbreeName) {

@@ -2,14 +2,14 @@
 // many instances use it) and a top-level structure over the instances' world bounds.
 #pragma once
 
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "accel/accelerator.h"
 #include "accel/instances.h"
 #include "accel/params.h"
 #include "tracer/scene.h"
-
-#include <memory>
-#include <string>
-#include <vector>
 
 namespace ab {
 
@@ -19,18 +19,24 @@ namespace ab {
 class SceneAccelerator final : public Accelerator {
  public:
   /// Creates (does not build) the structures; throws UnknownAccelerator or ParamError.
-  SceneAccelerator(std::shared_ptr<const Scene> scene, std::string top, std::string bottom, const Params& params);
+  SceneAccelerator(std::shared_ptr<const Scene> scene, std::string top, std::string bottom,
+                   const Params& params);
 
   std::string name() const override;
   nlohmann::json config() const override;
   AABB bounds() const override { return bounds_; }
 
-  void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override { top_->intersect(rays, hits); }
-  void occluded(std::span<const Ray> rays, std::span<uint8_t> out) const override { top_->occluded(rays, out); }
+  void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    top_->intersect(rays, hits);
+  }
+  void occluded(std::span<const Ray> rays, std::span<uint8_t> out) const override {
+    top_->occluded(rays, out);
+  }
   void intersect_counted(std::span<const Ray> rays, std::span<Hit> hits, RayCounters& total) const override {
     top_->intersect_counted(rays, hits, total);
   }
-  void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out, RayCounters& total) const override {
+  void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out,
+                        RayCounters& total) const override {
     top_->occluded_counted(rays, out, total);
   }
   void intersect_one(const Ray& ray, Hit& best, uint32_t inst, RayCounters* counters) const override {
@@ -66,8 +72,9 @@ Params level_params(const Params& params, const std::string& prefix, const std::
 
 /// Creates (not builds) the accelerator for a scene: Embree's own two-level instancing when both
 /// levels are `embree`, a SceneAccelerator otherwise. Empty top/bottom fall back to `name`.
-std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene> scene, const std::string& name,
-                                                    const Params& params, const std::string& top = "",
+std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene> scene,
+                                                    const std::string& name, const Params& params,
+                                                    const std::string& top = "",
                                                     const std::string& bottom = "");
 
 }  // namespace ab

@@ -1,12 +1,13 @@
 #include "tracer/transform.h"
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 
 namespace ab {
 
-glm::mat4 translate_matrix(const vec3& t) { return glm::translate(glm::mat4(1.0f), t); }
+glm::mat4 translate_matrix(const vec3& t) {
+  return glm::translate(glm::mat4(1.0f), t);
+}
 
 glm::mat4 rotate_matrix(const vec3& axis, float degrees) {
   // Rotations by multiples of 90 degrees are built exactly (no cos(pi/2) = -4e-8 residue), so
@@ -31,9 +32,13 @@ glm::mat4 rotate_matrix(const vec3& axis, float degrees) {
   return r;
 }
 
-glm::mat4 scale_matrix(const vec3& s) { return glm::scale(glm::mat4(1.0f), s); }
+glm::mat4 scale_matrix(const vec3& s) {
+  return glm::scale(glm::mat4(1.0f), s);
+}
 
-void Transform::then(const glm::mat4& m) { to_world = to_world * m; }
+void Transform::then(const glm::mat4& m) {
+  to_world = to_world * m;
+}
 
 bool Transform::finish() {
   const float det = glm::determinant(to_world);

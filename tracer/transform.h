@@ -8,9 +8,9 @@
 // then rotated by 90 degrees about Y, then translated by t.
 #pragma once
 
-#include "accel/geometry.h"
-
 #include <glm/glm.hpp>
+
+#include "accel/geometry.h"
 
 namespace ab {
 

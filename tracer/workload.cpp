@@ -1,10 +1,10 @@
 #include "tracer/workload.h"
 
+#include <cmath>
+
 #include "accel/error.h"
 #include "tracer/camera.h"
 #include "tracer/sampling.h"
-
-#include <cmath>
 
 namespace ab {
 
@@ -13,7 +13,9 @@ const std::vector<RayKindInfo>& scene_ray_kinds() {
       {"primary", "scene: the camera's pinhole rays, scanline order, jittered in the pixel"},
       {"dof", "scene: thin-lens rays (the camera's aperture, or 1/64 of the focal distance when it is 0)"},
       {"shadow", "scene: from primary hits to sampled points on the area lights (point lights if none)"},
-      {"glossy", "scene: glossy reflection (Phong lobe of the material's roughness, 0.1 if not glossy) at primary hits"},
+      {"glossy",
+       "scene: glossy reflection (Phong lobe of the material's roughness, 0.1 if not glossy) at primary "
+       "hits"},
       {"diffuse", "scene: cosine-weighted bounce at primary hits"}};
   return kinds;
 }
@@ -38,8 +40,8 @@ class CameraSweep {
  public:
   CameraSweep(const Scene& scene, uint64_t count, bool lens) : camera_(scene.camera) {
     if (lens && camera_.aperture <= 0.0f) {
-      const float focal = camera_.focal_distance > 0 ? camera_.focal_distance
-                                                     : glm::length(camera_.look_at - camera_.eye);
+      const float focal =
+          camera_.focal_distance > 0 ? camera_.focal_distance : glm::length(camera_.look_at - camera_.eye);
       camera_.aperture = focal / 64.0f;
     }
     if (!lens) camera_.aperture = 0.0f;
@@ -64,7 +66,8 @@ class CameraSweep {
 };
 
 /// One secondary ray of `kind` from the hit of primary ray `ray` (rng: that ray's generator).
-Ray secondary(const Scene& scene, const std::string& kind, const Ray& ray, const Hit& hit, float eps, Rng& rng) {
+Ray secondary(const Scene& scene, const std::string& kind, const Ray& ray, const Hit& hit, float eps,
+              Rng& rng) {
   const vec3 p = ray.org + hit.t * ray.dir;
   const vec3 d = glm::normalize(ray.dir);
   vec3 nf = glm::normalize(scene.hit_normal(hit));
@@ -98,8 +101,8 @@ Ray secondary(const Scene& scene, const std::string& kind, const Ray& ray, const
 
 }  // namespace
 
-std::vector<Ray> make_scene_rays(const Scene& scene, const TraceFn& trace, const std::string& kind, uint64_t count,
-                                 uint64_t seed) {
+std::vector<Ray> make_scene_rays(const Scene& scene, const TraceFn& trace, const std::string& kind,
+                                 uint64_t count, uint64_t seed) {
   if (!is_scene_ray_kind(kind)) {
     std::string known;
     for (const auto& k : scene_ray_kinds()) known += (known.empty() ? "" : ", ") + k.name;
@@ -119,7 +122,8 @@ std::vector<Ray> make_scene_rays(const Scene& scene, const TraceFn& trace, const
   std::vector<Ray> primary;
   std::vector<Hit> hits;
   for (uint64_t start = 0; out.size() < count; start += batch) {
-    if (start >= limit) throw InputError(scene.path + ": the camera sees too little geometry for " + kind + " rays");
+    if (start >= limit)
+      throw InputError(scene.path + ": the camera sees too little geometry for " + kind + " rays");
     primary.resize(batch);
     hits.assign(batch, Hit{});
     for (uint64_t j = 0; j < batch; ++j) primary[j] = sweep.ray(start + j, seed);

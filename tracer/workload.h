@@ -1,14 +1,14 @@
 // The tracer's rays as benchmark workloads: exactly the kinds of rays a render of the scene casts.
 #pragma once
 
-#include "datasets/rays.h"
-#include "tracer/scene.h"
-
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
 #include <vector>
+
+#include "datasets/rays.h"
+#include "tracer/scene.h"
 
 namespace ab {
 
@@ -23,8 +23,8 @@ using TraceFn = std::function<void(std::span<const Ray>, std::span<Hit>)>;
 /// Makes exactly `count` rays of a tracer kind; deterministic in (scene, kind, count, seed).
 /// Secondary kinds start at the hits of primary rays (misses are skipped). Throws InputError for an
 /// unknown kind, a scene without lights (shadow) or a camera that sees no geometry.
-std::vector<Ray> make_scene_rays(const Scene& scene, const TraceFn& trace, const std::string& kind, uint64_t count,
-                                 uint64_t seed);
+std::vector<Ray> make_scene_rays(const Scene& scene, const TraceFn& trace, const std::string& kind,
+                                 uint64_t count, uint64_t seed);
 
 /// Distance by which secondary rays leave a surface, for geometry within `bounds`.
 float surface_epsilon(const AABB& bounds);
