@@ -464,6 +464,13 @@ void Runner::time_closest(const Accelerator& accel, const std::string& name, Ray
 }
 
 void Runner::time_any(const Accelerator& accel, const std::string& name, RaySet& set, bool exact, json row) {
+  if (exact) {  // the any-hit counting pass (one thread; counters never run on the timed path)
+    std::vector<uint8_t> counted(set.rays.size());
+    RayCounters c;
+    accel.occluded_counted(set.rays, counted, c);
+    row.update(to_json(c, set.rays.size()));
+    row["havran_cost_per_ray"] = row["nodes_per_ray"].get<double>() + row["prims_per_ray"].get<double>();
+  }
   for (int threads : suite_.threads) {
     if (stopping()) return;
     std::vector<uint8_t> out(set.rays.size());
