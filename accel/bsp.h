@@ -1,11 +1,13 @@
 // BSP tree with arbitrary split planes (Ize, Wald and Parker 2008, "Ray tracing with the BSP tree";
-// Kammaje and Mora 2007): candidate planes and their cost in bsp_candidates.h, a conservative partition
+// Kammaje and Mora 2007): candidate planes in bsp_candidates.h, their cost over the node's convex cell
+// (bsp_cell.h), a conservative partition
 // (a primitive within the insertion margin of the plane goes to both sides), and the same robust
 // front-to-back stack traversal as the k-d trees with t_split = (d - n.o) / (n.dir).
 #pragma once
 
 #include "accel/accelerator.h"
 #include "accel/bsp_candidates.h"
+#include "accel/bsp_cell.h"
 #include "accel/kd_node.h"
 #include "accel/params.h"
 #include "accel/split_plane.h"
@@ -13,6 +15,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include <memory>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -68,6 +71,9 @@ struct BspBuffer {
   }
 };
 
+/// True when the plane's normal is not one of the three axes.
+inline bool is_oblique(const BspPlane& p) { return !(p.n.x == 1.0f || p.n.y == 1.0f || p.n.z == 1.0f); }
+
 /// Settings of the BSP builder.
 struct BspSettings {
   float traversal_cost = 1.0f;
@@ -88,7 +94,7 @@ class BspBuilder {
 
   /// Builds over ids (finite bounds) inside box into out.
   void build(std::vector<uint32_t> ids, const AABB& box, BspBuffer& out) const {
-    build_node(std::move(ids), box, 0, out);
+    build_node(std::move(ids), ConvexCell::from_box(box), {}, 0, out);
   }
 
  private:
@@ -96,96 +102,158 @@ class BspBuilder {
     BspPlane plane;
     float cost = kInf;
   };
+  /// The node's primitives that reach its cell's (grown) bounding box, each with the support points of
+  /// its part inside that box: classifying the clipped part, not the whole primitive, keeps long
+  /// primitives from being duplicated into every cell their supporting line or plane crosses.
+  struct NodePrims {
+    std::vector<uint32_t> ids;
+    std::vector<uint32_t> start{0};
+    std::vector<vec3> pts;
+    size_t size() const { return ids.size(); }
+  };
 
-  void build_node(std::vector<uint32_t>&& ids, const AABB& cell, int depth, BspBuffer& out) const {
-    const size_t n = ids.size();
+  /// A half-space dot(n, x) <= offset bounding the cell (already grown by the margin).
+  struct HalfSpace {
+    vec3 n;
+    float offset;
+  };
+
+  NodePrims gather(const std::vector<uint32_t>& ids, const ConvexCell& cell, const std::vector<HalfSpace>& path) const {
+    AABB box = cell.bounds();
+    box = {box.lo - vec3(s_.margin), box.hi + vec3(s_.margin)};
+    NodePrims np;
+    vec3 buf[kMaxSupportPoints];
+    for (uint32_t id : ids) {
+      int k = support_points(prims_, id, box, buf);
+      if constexpr (std::is_same_v<P, TrianglePrims>) k = clip_to_path(buf, k, path);
+      if (k == 0) continue;
+      np.ids.push_back(id);
+      np.pts.insert(np.pts.end(), buf, buf + k);
+      np.start.push_back(uint32_t(np.pts.size()));
+    }
+    return np;
+  }
+
+  /// Clips a triangle's polygon by the oblique half-spaces of the path (the box took care of the axes).
+  /// Stops clipping (keeping a superset) before the polygon could outgrow its fixed capacity.
+  static int clip_to_path(vec3* pts, int k, const std::vector<HalfSpace>& path) {
+    if (k == 0 || path.empty()) return k;
+    ClipPolygon poly;
+    std::copy(pts, pts + k, poly.v.begin());
+    poly.n = k;
+    for (const HalfSpace& h : path) {
+      if (poly.n == 0 || poly.n + 2 >= int(poly.v.size())) break;
+      clip_polygon(poly, h.n, h.offset);
+    }
+    std::copy(poly.v.begin(), poly.v.begin() + poly.n, pts);
+    return poly.n;
+  }
+
+  void build_node(std::vector<uint32_t>&& ids, const ConvexCell& cell, const std::vector<HalfSpace>& path, int depth,
+                  BspBuffer& out) const {
+    NodePrims np = gather(ids, cell, path);
+    std::vector<uint32_t>().swap(ids);
+    const size_t n = np.size();
     Choice best;
-    if (n > 1 && depth < s_.max_depth) best = find_plane(ids, cell);
+    if (n > 1 && depth < s_.max_depth) best = find_plane(np, cell);
     std::vector<uint32_t> left, right;
-    if (best.cost < s_.intersection_cost * float(n)) partition(ids, best.plane, left, right);
+    if (best.cost < s_.intersection_cost * float(n)) partition(np, best.plane, left, right);
     if ((left.empty() && right.empty()) || (left.size() == n && right.size() == n)) {
       out.nodes.push_back(BspNode::leaf(uint32_t(out.prims.size()), uint32_t(n)));
-      out.prims.insert(out.prims.end(), ids.begin(), ids.end());
+      out.prims.insert(out.prims.end(), np.ids.begin(), np.ids.end());
       return;
     }
-    std::vector<uint32_t>().swap(ids);
-    const AABB lcell = cut_box(cell, best.plane, true), rcell = cut_box(cell, best.plane, false);
+    np = NodePrims{};
+    const ConvexCell lcell = cell.part(best.plane, true), rcell = cell.part(best.plane, false);
+    std::vector<HalfSpace> lpath = path, rpath = path;
+    if (is_oblique(best.plane)) {
+      lpath.push_back({best.plane.n, best.plane.d + s_.margin});
+      rpath.push_back({-best.plane.n, -best.plane.d + s_.margin});
+    }
     const size_t self = out.nodes.size();
     const uint32_t plane = uint32_t(out.planes.size());
     out.planes.push_back(best.plane);
     out.nodes.push_back(BspNode::leaf(0, 0));
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, depth + 1, lb); },
-                           [&] { build_node(std::move(right), rcell, depth + 1, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lpath, depth + 1, lb); },
+                           [&] { build_node(std::move(right), rcell, rpath, depth + 1, rb); });
       out.append(lb);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lcell, depth + 1, out);
+      build_node(std::move(left), lcell, lpath, depth + 1, out);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rcell, depth + 1, out);
+      build_node(std::move(right), rcell, rpath, depth + 1, out);
     }
   }
 
-  /// Extent of primitive i along unit direction n.
-  void extent(uint32_t i, const vec3& n, float& lo, float& hi) const {
-    vec3 pts[8];
-    const int k = support_points(prims_, i, pts);
+  /// Signed-distance range of primitive k's support points from plane (dir, d).
+  static void range(const NodePrims& np, size_t k, const vec3& n, float d, float& lo, float& hi) {
     lo = kInf;
     hi = -kInf;
-    for (int j = 0; j < k; ++j) {
-      const float d = glm::dot(n, pts[j]);
-      lo = std::min(lo, d);
-      hi = std::max(hi, d);
+    for (uint32_t j = np.start[k]; j < np.start[k + 1]; ++j) {
+      const float x = glm::dot(n, np.pts[j]) - d;
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
     }
   }
 
-  float cost(const AABB& cell, float inv_area, const BspPlane& plane, size_t nl, size_t nr) const {
-    const float al = cut_box(cell, plane, true).area() * inv_area;
-    const float ar = cut_box(cell, plane, false).area() * inv_area;
+  float cost(const ConvexCell& cell, float inv_area, const BspPlane& plane, size_t nl, size_t nr) const {
+    float al = 0.0f, ar = 0.0f;
+    cell.areas(plane, al, ar);
     const float lambda = (nl == 0 || nr == 0) ? 1.0f - s_.empty_bonus : 1.0f;
-    return lambda * (s_.traversal_cost + s_.intersection_cost * (al * float(nl) + ar * float(nr)));
+    return lambda * (s_.traversal_cost + s_.intersection_cost * inv_area * (al * float(nl) + ar * float(nr)));
   }
 
-  Choice find_plane(const std::vector<uint32_t>& ids, const AABB& cell) const {
+  Choice find_plane(const NodePrims& np, const ConvexCell& cell) const {
     Choice best;
     const float area = cell.area();
     if (!(area > 0.0f)) return best;
     const float inv_area = 1.0f / area;
-    for (const vec3& dir : bsp_directions()) binned_planes(ids, cell, inv_area, dir, best);
-    const size_t k = std::min<size_t>(ids.size(), size_t(s_.autopartition));
+    for (const vec3& dir : bsp_directions()) binned_planes(np, cell, inv_area, dir, best);
+    const size_t k = std::min<size_t>(np.size(), size_t(s_.autopartition));
     for (size_t j = 0; j < k; ++j) {
-      BspPlane plane;
-      if (!supporting_plane(prims_, ids[j * ids.size() / k], plane)) continue;
-      size_t nl = 0, nr = 0;
-      count_sides(ids, plane, nl, nr);
-      const float c = cost(cell, inv_area, plane, nl, nr);
-      if (c < best.cost) best = {plane, c};
+      BspPlane own;
+      if (!supporting_plane(prims_, np.ids[j * np.size() / k], own)) continue;
+      // The plane itself and the plane moved two margins to either side, which puts the primitives
+      // lying in it on one side only (like the planar events of Wald and Havran 2006).
+      for (float shift : {0.0f, -2.0f * s_.margin, 2.0f * s_.margin}) {
+        const BspPlane plane{own.n, own.d + shift};
+        size_t nl = 0, nr = 0;
+        for (size_t i = 0; i < np.size(); ++i) {
+          const int s = side(np, i, plane);
+          nl += s & 1;
+          nr += s >> 1;
+        }
+        const float c = cost(cell, inv_area, plane, nl, nr);
+        if (c < best.cost) best = {plane, c};
+      }
     }
     return best;
   }
 
-  /// Planes of direction dir at the bin boundaries of the primitives' extents (Wald 2007's binning, with
-  /// a primitive counted on every side its extent reaches).
-  void binned_planes(const std::vector<uint32_t>& ids, const AABB& cell, float inv_area, const vec3& dir,
+  /// Planes of direction dir at the bin boundaries of the clipped primitives' extents (Wald 2007's
+  /// binning, a primitive counted on every side its extent reaches).
+  void binned_planes(const NodePrims& np, const ConvexCell& cell, float inv_area, const vec3& dir,
                      Choice& best) const {
-    const int bins = int(std::min<size_t>(size_t(s_.bins), ids.size() + 1));
-    std::vector<float> lo(ids.size()), hi(ids.size());
+    const size_t n = np.size();
+    const int bins = int(std::min<size_t>(size_t(s_.bins), n + 1));
+    std::vector<float> lo(n), hi(n);
     float range_lo = kInf, range_hi = -kInf;
-    for (size_t i = 0; i < ids.size(); ++i) {
-      extent(ids[i], dir, lo[i], hi[i]);
+    for (size_t i = 0; i < n; ++i) {
+      range(np, i, dir, 0.0f, lo[i], hi[i]);
       range_lo = std::min(range_lo, lo[i]);
       range_hi = std::max(range_hi, hi[i]);
     }
     if (!(range_hi > range_lo)) return;
     std::vector<uint32_t> starts(bins, 0), ends(bins, 0);
     const float scale = float(bins) / (range_hi - range_lo);
-    for (size_t i = 0; i < ids.size(); ++i) {
+    for (size_t i = 0; i < n; ++i) {
       ++starts[std::clamp(int((lo[i] - range_lo) * scale), 0, bins - 1)];
       ++ends[std::clamp(int((hi[i] - range_lo) * scale), 0, bins - 1)];
     }
-    size_t nl = 0, nr = ids.size();
+    size_t nl = 0, nr = n;
     for (int j = 1; j < bins; ++j) {
       nl += starts[j - 1];
       nr -= ends[j - 1];
@@ -195,33 +263,19 @@ class BspBuilder {
     }
   }
 
-  /// Side of primitive i: bit 0 below, bit 1 above (both when within the margin of the plane).
-  int side(uint32_t i, const BspPlane& plane) const {
-    vec3 pts[8];
-    const int k = support_points(prims_, i, pts);
-    float lo = kInf, hi = -kInf;
-    for (int j = 0; j < k; ++j) {
-      const float d = plane.distance(pts[j]);
-      lo = std::min(lo, d);
-      hi = std::max(hi, d);
-    }
+  /// Side of primitive k: bit 0 below, bit 1 above (both when its clipped part comes within the margin).
+  int side(const NodePrims& np, size_t k, const BspPlane& plane) const {
+    float lo, hi;
+    range(np, k, plane.n, plane.d, lo, hi);
     return (lo <= s_.margin ? 1 : 0) | (hi >= -s_.margin ? 2 : 0);
   }
 
-  void count_sides(const std::vector<uint32_t>& ids, const BspPlane& plane, size_t& nl, size_t& nr) const {
-    for (uint32_t i : ids) {
-      const int s = side(i, plane);
-      nl += s & 1;
-      nr += s >> 1;
-    }
-  }
-
-  void partition(const std::vector<uint32_t>& ids, const BspPlane& plane, std::vector<uint32_t>& left,
+  void partition(const NodePrims& np, const BspPlane& plane, std::vector<uint32_t>& left,
                  std::vector<uint32_t>& right) const {
-    for (uint32_t i : ids) {
-      const int s = side(i, plane);
-      if (s & 1) left.push_back(i);
-      if (s & 2) right.push_back(i);
+    for (size_t k = 0; k < np.size(); ++k) {
+      const int s = side(np, k, plane);
+      if (s & 1) left.push_back(np.ids[k]);
+      if (s & 2) right.push_back(np.ids[k]);
     }
   }
 
@@ -375,8 +429,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
     st.extra["depth_limit"] = depth_limit;
     st.extra["unbounded_primitives"] = unbounded_.size();
     size_t axis_planes = 0;
-    for (const BspPlane& p : planes_)
-      axis_planes += (p.n.x == 1.0f || p.n.y == 1.0f || p.n.z == 1.0f);
+    for (const BspPlane& p : planes_) axis_planes += !is_oblique(p);
     st.extra["axis_aligned_planes"] = axis_planes;
     st.extra["oblique_planes"] = planes_.size() - axis_planes;
     std::vector<std::pair<uint32_t, uint32_t>> todo;

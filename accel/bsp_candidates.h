@@ -3,8 +3,7 @@
 // tracing"): planes from a fixed set of 13 directions (the 3 axes, the 6 face diagonals and the 4 cube
 // diagonals), positioned at bin boundaries of the primitives' extents along each direction, plus the
 // supporting planes of a few of the node's own triangles (the autopartition). A plane is scored by the
-// SAH over the node's convex cell, approximated here by its bounding box: the areas of the two children are
-// the areas of the bounding boxes of the box cut by the plane.
+// SAH over the node's convex cell (bsp_cell.h). cut_box gives the bounding box of a box cut by a plane.
 #pragma once
 
 #include "accel/geometry.h"
@@ -40,17 +39,28 @@ inline const std::array<vec3, 13>& bsp_directions() {
   return dirs;
 }
 
-/// The points whose convex hull holds primitive i: a triangle's vertices.
-inline int support_points(const TrianglePrims& p, size_t i, vec3* out) {
+/// Most support points a primitive can have in a cell (a triangle clipped by a box).
+inline constexpr int kMaxSupportPoints = 32;
+
+/// The points whose convex hull holds the part of triangle i inside box: the triangle clipped to the box
+/// (Sutherland-Hodgman, clip.h). Zero points when it misses the box.
+inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec3* out) {
   const Triangle& t = p.triangle(i);
-  out[0] = t.v0;
-  out[1] = t.v1;
-  out[2] = t.v2;
-  return 3;
+  ClipPolygon poly;
+  poly.v[0] = t.v0;
+  poly.v[1] = t.v1;
+  poly.v[2] = t.v2;
+  poly.n = 3;
+  const AABB tb = t.bounds();
+  if (!tb.overlaps(box)) return 0;
+  if (!(box.contains(tb.lo) && box.contains(tb.hi))) clip_polygon_to_box(poly, box);
+  for (int k = 0; k < poly.n; ++k) out[k] = poly.v[k];
+  return poly.n;
 }
-/// An instance's support points: the eight corners of its world box.
-inline int support_points(const InstancePrims& p, size_t i, vec3* out) {
-  const AABB b = p.bounds(i);
+/// An instance's support points in box: the corners of its world box clipped to box.
+inline int support_points(const InstancePrims& p, size_t i, const AABB& box, vec3* out) {
+  const AABB b = AABB::intersection(p.bounds(i), box);
+  if (b.empty()) return 0;
   for (int c = 0; c < 8; ++c) out[c] = vec3((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z);
   return 8;
 }

@@ -155,7 +155,6 @@ class Octree final : public AcceleratorBase<Octree<P>> {
     const vec3 e = b.extent();
     float half = 0.5f * std::max({e.x, e.y, e.z});
     if (!(half > 0.0f)) half = std::max(1.0f, std::max({std::fabs(c.x), std::fabs(c.y), std::fabs(c.z)})) * 0x1p-10f;
-    half *= 1.0f + 0x1p-12f;
     AABB out{c - vec3(half), c + vec3(half)};
     out.extend(b);  // rounding never leaves a vertex outside
     return out;
