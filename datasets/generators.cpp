@@ -43,10 +43,12 @@ void add_sphere(MeshBuilder& out, const vec3& center, float radius, uint32_t seg
   for (uint32_t s = 0; s < segments; ++s) out.triangle(south, at(rings - 1, s), at(rings - 1, s + 1));
 }
 
-/// Adds a sphere tessellated with about `budget` triangles (at least 6).
-uint64_t add_sphere_budget(MeshBuilder& out, const vec3& center, float radius, double budget) {
+/// Adds a sphere tessellated with about `budget` triangles (at least 6; at least `budget` when
+/// `at_least`, so that the last sphere of a flake never leaves the total short).
+uint64_t add_sphere_budget(MeshBuilder& out, const vec3& center, float radius, double budget, bool at_least) {
   const uint32_t rings = static_cast<uint32_t>(std::max(1.0, std::round(std::sqrt(std::max(budget, 0.0) / 4.0))));
-  const uint32_t segments = static_cast<uint32_t>(std::max(3.0, std::round(budget / (2.0 * rings))));
+  const double per_ring = budget / (2.0 * rings);
+  const uint32_t segments = static_cast<uint32_t>(std::max(3.0, at_least ? std::ceil(per_ring) : std::round(per_ring)));
   add_sphere(out, center, radius, segments, rings);
   return 2ull * segments * rings;
 }
@@ -86,7 +88,7 @@ void frame(const vec3& a, vec3& t, vec3& b) {
 void add_flake(Flake& f, const vec3& center, float radius, const vec3& axis, int depth) {
   const double budget = static_cast<double>(f.target - std::min(f.target, f.out.triangles())) /
                         static_cast<double>(f.spheres_left);
-  add_sphere_budget(f.out, center, radius, budget);
+  add_sphere_budget(f.out, center, radius, budget, f.spheres_left == 1);
   --f.spheres_left;
   if (depth == 0) return;
   vec3 t, b;
@@ -329,7 +331,7 @@ void add_building(MeshBuilder& out, const vec3& lo, const vec3& hi, bool duplica
 Mesh make_cityscape(uint64_t triangles, uint64_t seed, Params& params) {
   const int max_height = static_cast<int>(params.get_int("height", 24, 1, 100000));
   const bool degenerate = params.get_bool("degenerate", true);
-  const uint32_t lots = static_cast<uint32_t>(std::max(1.0, std::ceil(std::sqrt(triangles / 10.2))));
+  const uint32_t lots = static_cast<uint32_t>(std::max(1.0, std::ceil(std::sqrt(triangles / 9.5))));
   const float extent = 4.0f * static_cast<float>(lots);
   MeshBuilder out(triangles + 16, triangles + 16);
   const uint32_t g0 = out.vertex({-4.0f, 0.0f, -4.0f}), g1 = out.vertex({extent + 4.0f, 0.0f, -4.0f});
@@ -377,9 +379,11 @@ Mesh generate_mesh(const std::string& name, uint64_t triangles, uint64_t seed, P
     if (triangles > kMaxTriangles)
       throw InputError("generator '" + name + "': " + std::to_string(triangles) + " triangles is more than the limit " +
                        std::to_string(kMaxTriangles));
-    Mesh mesh = g.make(triangles, seed, params);
-    params.finish("generator '" + name + "'");
-    return mesh;
+    // A dry run on zero triangles rejects unknown or bad parameters before the real (maybe long) run.
+    Params probe = params;
+    g.make(0, seed, probe);
+    probe.finish("generator '" + name + "'");
+    return g.make(triangles, seed, params);
   }
   std::string known;
   for (const GeneratorInfo& g : generators()) known += (known.empty() ? "" : ", ") + g.name;

@@ -41,7 +41,7 @@ TEST(Generators, ListHasTheRequiredNamesWithDescriptions) {
 
 TEST(Generators, TriangleCountMatchesTheTarget) {
   for (const GeneratorInfo& g : generators())
-    for (uint64_t n : {1ull, 7ull, 1000ull, 100000ull}) {
+    for (uint64_t n : {1ull, 2ull, 3ull, 7ull, 12ull, 13ull, 50ull, 333ull, 1000ull, 4097ull, 100000ull}) {
       const Mesh m = generate_mesh(g.name, n, 1, Params());
       SCOPED_TRACE(g.name + " " + std::to_string(n));
       EXPECT_GE(m.size(), 1u);
