@@ -34,19 +34,24 @@ class MeshImporter : public OpenMesh::IO::BaseImporter {
   /// Faces received (polygons, before triangulation).
   size_t faces() const { return faces_; }
 
+  /// Appends a vertex; its handle is its index.
   VertexHandle add_vertex(const OpenMesh::Vec3f& p) override {
     mesh_.vertices.emplace_back(p[0], p[1], p[2]);
     return VertexHandle(static_cast<int>(mesh_.vertices.size() - 1));
   }
+  /// Appends a vertex given in double precision (rounded to float).
   VertexHandle add_vertex(const OpenMesh::Vec3d& p) override {
     return add_vertex(OpenMesh::Vec3f(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])));
   }
+  /// Appends a vertex at the origin (set later by set_point).
   VertexHandle add_vertex() override { return add_vertex(OpenMesh::Vec3f(0.0f, 0.0f, 0.0f)); }
+  /// Moves an existing vertex.
   void set_point(VertexHandle vh, const OpenMesh::Vec3f& p) override {
     if (vh.is_valid() && static_cast<size_t>(vh.idx()) < mesh_.vertices.size())
       mesh_.vertices[static_cast<size_t>(vh.idx())] = {p[0], p[1], p[2]};
   }
 
+  /// Fan-triangulates a face in file order, or records why it cannot.
   FaceHandle add_face(const VHandles& indices) override {
     const size_t face = faces_++;
     for (const VertexHandle& vh : indices)
@@ -60,13 +65,15 @@ class MeshImporter : public OpenMesh::IO::BaseImporter {
       mesh_.triangles.emplace_back(indices[0].idx(), indices[i - 1].idx(), indices[i].idx());
     return FaceHandle(static_cast<int>(face));
   }
+  /// Not used by the format readers; recorded as an error.
   FaceHandle add_face(HalfedgeHandle) override {
     fail("halfedge-based faces are not supported");
     return FaceHandle();
   }
+  /// No halfedges are kept.
   HalfedgeHandle add_edge(VertexHandle, VertexHandle) override { return HalfedgeHandle(); }
 
-  // Attributes the benchmark does not use: accepted and dropped.
+  /// Attributes the benchmark does not use (normals, colours, texture coordinates, status): accepted and dropped.
   void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec2f>&) override {}
   void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec3f>&) override {}
   void set_face_texindex(FaceHandle, int) override {}
@@ -100,13 +107,17 @@ class MeshImporter : public OpenMesh::IO::BaseImporter {
   void set_status(FaceHandle, const StatusInfo&) override {}
   void add_texture_information(int, std::string) override {}
 
+  /// Reserves room for the counts a header declares (capped).
   void reserve(unsigned int vertices, unsigned int, unsigned int faces) override {
     // Header counts are untrusted: reserve at most 2^26 up front, grow beyond that as data arrives.
     mesh_.vertices.reserve(std::min(vertices, 1u << 26));
     mesh_.triangles.reserve(std::min(faces, 1u << 26));
   }
+  /// Vertices so far.
   size_t n_vertices() const override { return mesh_.vertices.size(); }
+  /// Faces so far (before triangulation).
   size_t n_faces() const override { return faces_; }
+  /// Always 0 (no edges are kept).
   size_t n_edges() const override { return 0; }
 
  private:
