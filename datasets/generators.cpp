@@ -180,6 +180,7 @@ Mesh make_terrain(uint64_t triangles, uint64_t seed, Params& params) {
 // ---------------------------------------------------------------------------------------------
 // Tetra
 
+/// Sierpinski tetrahedron state: where leaves go and how many of them are refined once more.
 struct Tetra {
   MeshBuilder& out;
   uint64_t refine;  ///< leaves (in emission order) that are subdivided once more
