@@ -295,7 +295,7 @@ void add_stadium_bowl(MeshBuilder& out, const vec3& lo, const vec3& hi) {
 }
 
 Mesh make_stadium(uint64_t triangles, uint64_t /*seed*/, Params& params) {
-  const float scale = static_cast<float>(params.get_float("scale", 1000.0, 1.0, 1e6));
+  const float scale = static_cast<float>(params.get_float("scale", 100.0, 1.0, 1e6));
   const int depth = static_cast<int>(params.get_int("depth", -1, -1, 7));
   MeshBuilder out(triangles + 64, triangles / 2 + 64);
   const float half = 0.5f * scale;
