@@ -384,6 +384,7 @@ Mesh generate_mesh(const std::string& name, uint64_t triangles, uint64_t seed, P
     Params probe = params;
     g.make(0, seed, probe);
     probe.finish("generator '" + name + "'");
+    if (triangles == 0) return Mesh{};
     return g.make(triangles, seed, params);
   }
   std::string known;

@@ -206,7 +206,8 @@ Mesh read_mesh(const std::string& path) {
   if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
     throw InputError(path + ": unknown mesh format '" + ext + "' (expected .obj, .ply, .off or .stl)");
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such file");
+  if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw InputError(path + ": cannot open file");
   probe.close();

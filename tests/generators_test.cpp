@@ -51,7 +51,11 @@ TEST(Generators, TriangleCountMatchesTheTarget) {
 }
 
 TEST(Generators, ZeroTrianglesGivesAnEmptyMesh) {
-  for (const GeneratorInfo& g : generators()) EXPECT_EQ(generate_mesh(g.name, 0, 1, Params()).size(), 0u) << g.name;
+  for (const GeneratorInfo& g : generators()) {
+    const Mesh m = generate_mesh(g.name, 0, 1, Params());
+    EXPECT_EQ(m.size(), 0u) << g.name;
+    EXPECT_TRUE(m.vertices.empty()) << g.name;
+  }
 }
 
 TEST(Generators, DeterministicBySeed) {

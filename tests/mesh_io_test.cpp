@@ -247,6 +247,8 @@ void expect_input_error(const std::string& file, const std::string& what) {
 
 TEST_F(MeshIoTest, MissingFileAndUnknownExtension) {
   expect_input_error(path("missing.obj"), "no such file");
+  fs::create_directories(path("folder.obj"));
+  expect_input_error(path("folder.obj"), "not a regular file");
   expect_input_error(write("a.xyz", obj_text()), "unknown mesh format");
   expect_input_error(write("noext", obj_text()), "unknown mesh format");
   EXPECT_THROW(write_mesh(soup_mesh(), path("a.xyz")), InputError);
