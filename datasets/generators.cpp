@@ -1,13 +1,13 @@
 #include "datasets/generators.h"
 
-#include "accel/error.h"
-#include "datasets/mesh_builder.h"
-#include "datasets/random.h"
-
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+
+#include "accel/error.h"
+#include "datasets/mesh_builder.h"
+#include "datasets/random.h"
 
 namespace ab {
 namespace {
@@ -46,9 +46,11 @@ void add_sphere(MeshBuilder& out, const vec3& center, float radius, uint32_t seg
 /// Adds a sphere tessellated with about `budget` triangles (at least 6; at least `budget` when
 /// `at_least`, so that the last sphere of a flake never leaves the total short).
 uint64_t add_sphere_budget(MeshBuilder& out, const vec3& center, float radius, double budget, bool at_least) {
-  const uint32_t rings = static_cast<uint32_t>(std::max(1.0, std::round(std::sqrt(std::max(budget, 0.0) / 4.0))));
+  const uint32_t rings =
+      static_cast<uint32_t>(std::max(1.0, std::round(std::sqrt(std::max(budget, 0.0) / 4.0))));
   const double per_ring = budget / (2.0 * rings);
-  const uint32_t segments = static_cast<uint32_t>(std::max(3.0, at_least ? std::ceil(per_ring) : std::round(per_ring)));
+  const uint32_t segments =
+      static_cast<uint32_t>(std::max(3.0, at_least ? std::ceil(per_ring) : std::round(per_ring)));
   add_sphere(out, center, radius, segments, rings);
   return 2ull * segments * rings;
 }
@@ -98,7 +100,8 @@ void add_flake(Flake& f, const vec3& center, float radius, const vec3& axis, int
     const bool upper = i >= 6;
     const float phi = upper ? kPi / 6.0f + 2.0f * kPi * (i - 6) / 3.0f : 2.0f * kPi * i / 6.0f;
     const float elevation = upper ? 0.9f : 0.0f;
-    const vec3 dir = std::cos(elevation) * (std::cos(phi) * t + std::sin(phi) * b) + std::sin(elevation) * axis;
+    const vec3 dir =
+        std::cos(elevation) * (std::cos(phi) * t + std::sin(phi) * b) + std::sin(elevation) * axis;
     add_flake(f, center + (radius + child) * dir, child, glm::normalize(dir), depth - 1);
   }
 }
@@ -126,7 +129,8 @@ float value_noise(uint64_t seed, uint64_t octave, float x, float z) {
   const float fx = std::floor(x), fz = std::floor(z);
   const int64_t ix = static_cast<int64_t>(fx), iz = static_cast<int64_t>(fz);
   auto lattice = [&](int64_t i, int64_t k) {
-    const uint64_t h = hash_seed(seed, octave, static_cast<uint64_t>(i) * 0x100000001B3ull ^ static_cast<uint64_t>(k));
+    const uint64_t h =
+        hash_seed(seed, octave, static_cast<uint64_t>(i) * 0x100000001B3ull ^ static_cast<uint64_t>(k));
     return static_cast<float>(h >> 40) * 0x1p-23f - 1.0f;
   };
   auto smooth = [](float t) { return t * t * (3.0f - 2.0f * t); };
@@ -245,7 +249,8 @@ Mesh make_tetra(uint64_t triangles, uint64_t /*seed*/, Params& params) {
 // Soup and slivers
 
 Mesh make_soup(uint64_t triangles, uint64_t seed, Params& params) {
-  const double auto_size = std::min(0.1, 1.5 / std::cbrt(static_cast<double>(std::max<uint64_t>(triangles, 1))));
+  const double auto_size =
+      std::min(0.1, 1.5 / std::cbrt(static_cast<double>(std::max<uint64_t>(triangles, 1))));
   const float size = static_cast<float>(params.get_float("size", auto_size, 0.0, 10.0));
   MeshBuilder out(triangles, 3 * triangles);
   Rng rng(seed, 1);
@@ -286,7 +291,8 @@ Mesh make_slivers(uint64_t triangles, uint64_t seed, Params& params) {
 /// height hi.y - lo.y, open at the top so that a camera above it sees the floor and what stands on it.
 void add_stadium_bowl(MeshBuilder& out, const vec3& lo, const vec3& hi) {
   uint32_t v[8];
-  for (int i = 0; i < 8; ++i) v[i] = out.vertex({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  for (int i = 0; i < 8; ++i)
+    v[i] = out.vertex({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
   const int faces[5][4] = {{0, 1, 5, 4}, {0, 4, 6, 2}, {1, 3, 7, 5}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& f : faces) {
     out.triangle(v[f[0]], v[f[1]], v[f[2]]);
@@ -300,7 +306,8 @@ Mesh make_stadium(uint64_t triangles, uint64_t /*seed*/, Params& params) {
   MeshBuilder out(triangles + 64, triangles / 2 + 64);
   const float half = 0.5f * scale;
   add_stadium_bowl(out, vec3(-half, 0.0f, -half), vec3(half, 0.05f * scale, half));
-  if (triangles > out.triangles()) add_sphereflake(out, triangles - out.triangles(), depth, vec3(0, 1, 0), 1.0f);
+  if (triangles > out.triangles())
+    add_sphereflake(out, triangles - out.triangles(), depth, vec3(0, 1, 0), 1.0f);
   return out.finish(triangles);
 }
 
@@ -312,7 +319,8 @@ Mesh make_stadium(uint64_t triangles, uint64_t /*seed*/, Params& params) {
 /// (a repeated vertex, and three collinear vertices along a roof edge).
 void add_building(MeshBuilder& out, const vec3& lo, const vec3& hi, bool duplicate_roof, bool degenerate) {
   uint32_t v[8];
-  for (int i = 0; i < 8; ++i) v[i] = out.vertex({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  for (int i = 0; i < 8; ++i)
+    v[i] = out.vertex({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
   const int sides[5][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 2, 3, 1}, {4, 5, 7, 6}, {2, 6, 7, 3}};
   for (const auto& f : sides) {
     out.triangle(v[f[0]], v[f[1]], v[f[2]]);
@@ -336,7 +344,8 @@ Mesh make_cityscape(uint64_t triangles, uint64_t seed, Params& params) {
   const float extent = 4.0f * static_cast<float>(lots);
   MeshBuilder out(triangles + 16, triangles + 16);
   const uint32_t g0 = out.vertex({-4.0f, 0.0f, -4.0f}), g1 = out.vertex({extent + 4.0f, 0.0f, -4.0f});
-  const uint32_t g2 = out.vertex({-4.0f, 0.0f, extent + 4.0f}), g3 = out.vertex({extent + 4.0f, 0.0f, extent + 4.0f});
+  const uint32_t g2 = out.vertex({-4.0f, 0.0f, extent + 4.0f}),
+                 g3 = out.vertex({extent + 4.0f, 0.0f, extent + 4.0f});
   out.triangle(g0, g2, g3);
   out.triangle(g0, g3, g1);
   Rng rng(seed, 3);
@@ -348,8 +357,9 @@ Mesh make_cityscape(uint64_t triangles, uint64_t seed, Params& params) {
     const float w = 1.0f + static_cast<float>(rng.below(3)), d = 1.0f + static_cast<float>(rng.below(3));
     const uint64_t tall = rng.below(static_cast<uint64_t>(max_height));
     const uint64_t h = 1 + tall * rng.below(4) / 3;
-    add_building(out, {x0, 0.0f, z0}, {std::min(x0 + w, 4.0f * (k % lots) + 4.0f), static_cast<float>(h),
-                                       std::min(z0 + d, 4.0f * (k / lots) + 4.0f)},
+    add_building(out, {x0, 0.0f, z0},
+                 {std::min(x0 + w, 4.0f * (k % lots) + 4.0f), static_cast<float>(h),
+                  std::min(z0 + d, 4.0f * (k / lots) + 4.0f)},
                  k % 37 == 0, degenerate && k % 50 == 0);
   }
   return out.finish(triangles);
@@ -359,11 +369,15 @@ Mesh make_cityscape(uint64_t triangles, uint64_t seed, Params& params) {
 
 const std::vector<GeneratorInfo>& generators() {
   static const std::vector<GeneratorInfo> list = {
-      {"sphereflake", "Haines' SPD balls: recursive spheres, each tessellated (params depth)", make_sphereflake},
-      {"terrain", "fractal heightfield, fBm noise over a grid, SPD mount (params roughness, height)", make_terrain},
+      {"sphereflake", "Haines' SPD balls: recursive spheres, each tessellated (params depth)",
+       make_sphereflake},
+      {"terrain", "fractal heightfield, fBm noise over a grid, SPD mount (params roughness, height)",
+       make_terrain},
       {"tetra", "SPD tetra: recursive Sierpinski tetrahedra (params depth)", make_tetra},
       {"soup", "uniformly random small triangles in the unit cube (params size)", make_soup},
-      {"stadium", "teapot in a stadium: a dense sphereflake in the middle of a huge open-air stadium (params scale, depth)",
+      {"stadium",
+       "teapot in a stadium: a dense sphereflake in the middle of a huge open-air stadium (params scale, "
+       "depth)",
        make_stadium},
       {"slivers", "long thin triangles at random angles (params length, aspect)", make_slivers},
       {"cityscape",
@@ -378,8 +392,8 @@ Mesh generate_mesh(const std::string& name, uint64_t triangles, uint64_t seed, P
   for (const GeneratorInfo& g : generators()) {
     if (g.name != name) continue;
     if (triangles > kMaxTriangles)
-      throw InputError("generator '" + name + "': " + std::to_string(triangles) + " triangles is more than the limit " +
-                       std::to_string(kMaxTriangles));
+      throw InputError("generator '" + name + "': " + std::to_string(triangles) +
+                       " triangles is more than the limit " + std::to_string(kMaxTriangles));
     // A dry run on zero triangles rejects unknown or bad parameters before the real (maybe long) run.
     Params probe = params;
     g.make(0, seed, probe);

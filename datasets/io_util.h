@@ -2,8 +2,6 @@
 // output, and strict number parsing with the file and line in the error.
 #pragma once
 
-#include "accel/error.h"
-
 #include <bit>
 #include <charconv>
 #include <cstdint>
@@ -12,6 +10,8 @@
 #include <istream>
 #include <string>
 #include <string_view>
+
+#include "accel/error.h"
 
 namespace ab {
 
@@ -58,7 +58,8 @@ inline std::string_view next_token(std::string_view& rest) {
     return {};
   }
   const size_t end = rest.find_first_of(" \t\r", start);
-  const std::string_view token = rest.substr(start, end == std::string_view::npos ? rest.size() - start : end - start);
+  const std::string_view token =
+      rest.substr(start, end == std::string_view::npos ? rest.size() - start : end - start);
   rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end);
   return token;
 }

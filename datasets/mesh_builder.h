@@ -1,11 +1,11 @@
 // Appending vertices and triangles to a mesh, then trimming it to an exact triangle count.
 #pragma once
 
-#include "accel/mesh.h"
-
 #include <algorithm>
 #include <cstdint>
 #include <utility>
+
+#include "accel/mesh.h"
 
 namespace ab {
 

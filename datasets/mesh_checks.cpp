@@ -1,7 +1,5 @@
 #include "datasets/mesh_checks.h"
 
-#include "datasets/io_util.h"
-
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -9,11 +7,14 @@
 #include <sstream>
 #include <vector>
 
+#include "datasets/io_util.h"
+
 namespace ab {
 namespace {
 
-const std::set<std::string> kPlyTypes = {"char",  "uchar", "short", "ushort", "int",    "uint",    "float",   "double",
-                                         "int8",  "uint8", "int16", "uint16", "int32",  "uint32",  "float32", "float64"};
+const std::set<std::string> kPlyTypes = {"char",  "uchar",  "short",   "ushort", "int",   "uint",
+                                         "float", "double", "int8",    "uint8",  "int16", "uint16",
+                                         "int32", "uint32", "float32", "float64"};
 
 /// What the header check has seen of one element.
 struct PlyElement {
@@ -28,12 +29,14 @@ std::string ply_line_error(const std::string& path, size_t line, const std::stri
 }
 
 /// Checks one property line ("property TYPE NAME" or "property list COUNT_TYPE INDEX_TYPE NAME").
-void check_ply_property(std::istringstream& words, PlyElement* element, const std::string& path, size_t line) {
+void check_ply_property(std::istringstream& words, PlyElement* element, const std::string& path,
+                        size_t line) {
   std::string type, count_type, index_type, name;
   if (!element) throw InputError(ply_line_error(path, line, "property before any element"));
   words >> type;
   if (type == "list") {
-    if (!(words >> count_type >> index_type >> name) || !kPlyTypes.count(count_type) || !kPlyTypes.count(index_type))
+    if (!(words >> count_type >> index_type >> name) || !kPlyTypes.count(count_type) ||
+        !kPlyTypes.count(index_type))
       throw InputError(ply_line_error(path, line, "malformed list property"));
     element->lists.insert(name);
     element->properties.emplace_back(name, true);
@@ -54,7 +57,8 @@ void check_ply_elements(const std::vector<PlyElement>& elements, const std::stri
       if (!e.scalars.count("x") || !e.scalars.count("y") || !e.scalars.count("z"))
         throw InputError(path + ": the vertex element lacks an x, y or z property");
     }
-    if (e.name == "face" && e.lists.empty()) throw InputError(path + ": the face element has no list of vertex indices");
+    if (e.name == "face" && e.lists.empty())
+      throw InputError(path + ": the face element has no list of vertex indices");
   }
   if (!vertex) throw InputError(path + ": no vertex element in the PLY header");
 }
@@ -72,13 +76,16 @@ long long ply_integer(std::string_view token, const std::string& path, size_t li
 void check_ply_face_list(std::string_view& rest, long long vertices, long long face, const std::string& path,
                          size_t line) {
   const long long corners = ply_integer(next_token(rest), path, line);
-  if (corners < 3) throw InputError(ply_line_error(path, line, "face " + std::to_string(face) + " has fewer than three vertices"));
+  if (corners < 3)
+    throw InputError(
+        ply_line_error(path, line, "face " + std::to_string(face) + " has fewer than three vertices"));
   for (long long k = 0; k < corners; ++k) {
     const long long i = ply_integer(next_token(rest), path, line);
     if (i < 0 || i >= vertices)
-      throw InputError(ply_line_error(path, line, "face " + std::to_string(face) + " refers to vertex " +
-                                                      std::to_string(i) + ", but there are only " +
-                                                      std::to_string(vertices) + " vertices"));
+      throw InputError(ply_line_error(path, line,
+                                      "face " + std::to_string(face) + " refers to vertex " +
+                                          std::to_string(i) + ", but there are only " +
+                                          std::to_string(vertices) + " vertices"));
   }
 }
 
@@ -96,8 +103,8 @@ void check_ply_ascii_line(std::string_view rest, const PlyElement& e, long long 
       if (token.empty()) throw InputError(ply_line_error(path, line, "too few values for element " + e.name));
       const float f = parse_float(token, path, line);
       if (e.name == "vertex" && (name == "x" || name == "y" || name == "z") && !std::isfinite(f))
-        throw InputError(ply_line_error(path, line, "vertex " + std::to_string(index + 1) +
-                                                        " has a NaN or infinite coordinate"));
+        throw InputError(ply_line_error(
+            path, line, "vertex " + std::to_string(index + 1) + " has a NaN or infinite coordinate"));
     }
   }
 }
@@ -146,16 +153,20 @@ struct OffLines {
     const std::string_view t = token();
     long long value = -1;
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
-    if (t.empty() || ec != std::errc() || end != t.data() + t.size() || value < 0) throw error(std::string("expected ") + what);
+    if (t.empty() || ec != std::errc() || end != t.data() + t.size() || value < 0)
+      throw error(std::string("expected ") + what);
     return value;
   }
   /// An error naming the file and current line.
-  InputError error(const std::string& what) const { return InputError(path + ":" + std::to_string(line) + ": " + what); }
+  InputError error(const std::string& what) const {
+    return InputError(path + ":" + std::to_string(line) + ": " + what);
+  }
 };
 
 void check_off_vertices(OffLines& off, long long count) {
   for (long long v = 0; v < count; ++v) {
-    if (!off.next()) throw InputError(off.path + ": truncated: vertex " + std::to_string(v + 1) + " is missing");
+    if (!off.next())
+      throw InputError(off.path + ": truncated: vertex " + std::to_string(v + 1) + " is missing");
     for (int k = 0; k < 3; ++k) {
       const std::string_view t = off.token();
       if (t.empty()) throw off.error("a vertex needs three coordinates");
@@ -167,7 +178,8 @@ void check_off_vertices(OffLines& off, long long count) {
 
 void check_off_faces(OffLines& off, long long count, long long vertices) {
   for (long long f = 0; f < count; ++f) {
-    if (!off.next()) throw InputError(off.path + ": truncated: face " + std::to_string(f + 1) + " is missing");
+    if (!off.next())
+      throw InputError(off.path + ": truncated: face " + std::to_string(f + 1) + " is missing");
     const long long corners = off.integer("a corner count");
     if (corners < 3) throw off.error("face " + std::to_string(f + 1) + " has fewer than three vertices");
     for (long long k = 0; k < corners; ++k) {
@@ -184,7 +196,8 @@ void check_off_faces(OffLines& off, long long count, long long vertices) {
 void check_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string text, keyword;
-  if (!std::getline(in, text) || text.substr(0, 3) != "ply") throw InputError(path + ": not a PLY file (no 'ply' magic)");
+  if (!std::getline(in, text) || text.substr(0, 3) != "ply")
+    throw InputError(path + ": not a PLY file (no 'ply' magic)");
   std::vector<PlyElement> elements;
   bool format = false, ascii = false;
   for (size_t line = 2; line < 100000 && std::getline(in, text); ++line) {
@@ -223,7 +236,8 @@ void check_ascii_off(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   OffLines off{in, path, 0, {}, {}};
   const std::string_view keyword = off.next() ? off.token() : std::string_view{};
-  if (keyword.find("OFF") == std::string_view::npos) throw InputError(path + ": not an OFF file (no OFF keyword)");
+  if (keyword.find("OFF") == std::string_view::npos)
+    throw InputError(path + ": not an OFF file (no OFF keyword)");
   if (keyword != "OFF") return;  // COFF, NOFF, 4OFF, ... : left to OpenMesh
   if (off.rest.find_first_not_of(" \t\r") == std::string_view::npos && !off.next())
     throw InputError(path + ": truncated: no vertex and face counts");

@@ -2,13 +2,12 @@
 // structure, so non-manifold, duplicate and degenerate faces are all kept and ids never shift.
 #pragma once
 
-#include "accel/error.h"
-#include "accel/mesh.h"
-
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
-
 #include <algorithm>
 #include <string>
+
+#include "accel/error.h"
+#include "accel/mesh.h"
 
 namespace ab {
 
@@ -41,7 +40,8 @@ class MeshImporter : public OpenMesh::IO::BaseImporter {
   }
   /// Appends a vertex given in double precision (rounded to float).
   VertexHandle add_vertex(const OpenMesh::Vec3d& p) override {
-    return add_vertex(OpenMesh::Vec3f(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])));
+    return add_vertex(
+        OpenMesh::Vec3f(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])));
   }
   /// Appends a vertex at the origin (set later by set_point).
   VertexHandle add_vertex() override { return add_vertex(OpenMesh::Vec3f(0.0f, 0.0f, 0.0f)); }
@@ -73,7 +73,8 @@ class MeshImporter : public OpenMesh::IO::BaseImporter {
   /// No halfedges are kept.
   HalfedgeHandle add_edge(VertexHandle, VertexHandle) override { return HalfedgeHandle(); }
 
-  /// Attributes the benchmark does not use (normals, colours, texture coordinates, status): accepted and dropped.
+  /// Attributes the benchmark does not use (normals, colours, texture coordinates, status): accepted and
+  /// dropped.
   void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec2f>&) override {}
   void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec3f>&) override {}
   void set_face_texindex(FaceHandle, int) override {}

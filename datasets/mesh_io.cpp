@@ -1,5 +1,18 @@
 #include "datasets/mesh_io.h"
 
+#include <OpenMesh/Core/IO/IOManager.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
 #include "accel/error.h"
 #include "datasets/atomic_file.h"
 #include "datasets/io_util.h"
@@ -7,20 +20,6 @@
 #include "datasets/mesh_importer.h"
 #include "datasets/obj_reader.h"
 #include "datasets/stl_io.h"
-
-#include <OpenMesh/Core/IO/IOManager.hh>
-#include <OpenMesh/Core/System/omstream.hh>
-
-#include <algorithm>
-#include <bit>
-#include <cstring>
-#include <cctype>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <mutex>
-#include <sstream>
 
 namespace ab {
 namespace {
@@ -99,7 +98,8 @@ void write_obj(const Mesh& mesh, std::ostream& out) {
     put_float(out, p.z);
     out << '\n';
   }
-  for (const glm::uvec3& t : mesh.triangles) out << "f " << t.x + 1 << ' ' << t.y + 1 << ' ' << t.z + 1 << '\n';
+  for (const glm::uvec3& t : mesh.triangles)
+    out << "f " << t.x + 1 << ' ' << t.y + 1 << ' ' << t.z + 1 << '\n';
 }
 
 void write_off(const Mesh& mesh, std::ostream& out) {
@@ -117,9 +117,9 @@ void write_off(const Mesh& mesh, std::ostream& out) {
 
 /// Binary little-endian PLY: float vertices, faces as uchar count + uint indices.
 void write_ply(const Mesh& mesh, std::ostream& out) {
-  out << "ply\nformat binary_little_endian 1.0\ncomment accelbench mesh\nelement vertex " << mesh.vertices.size()
-      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << mesh.size()
-      << "\nproperty list uchar uint vertex_indices\nend_header\n";
+  out << "ply\nformat binary_little_endian 1.0\ncomment accelbench mesh\nelement vertex "
+      << mesh.vertices.size() << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
+      << mesh.size() << "\nproperty list uchar uint vertex_indices\nend_header\n";
   std::string buffer;
   buffer.reserve(1 << 20);
   auto flush = [&](bool force) {
@@ -143,7 +143,6 @@ void write_ply(const Mesh& mesh, std::ostream& out) {
   }
   flush(true);
 }
-
 
 /// Element counts a PLY header or an ASCII OFF header declares (-1 where unknown).
 struct DeclaredCounts {
@@ -217,8 +216,10 @@ Mesh read_mesh(const std::string& path) {
   } else if (ext == "obj") {
     mesh = read_obj(path);
   } else {
-    if (ext == "ply") check_ply(path);
-    else check_ascii_off(path);
+    if (ext == "ply")
+      check_ply(path);
+    else
+      check_ascii_off(path);
     MeshImporter importer(mesh);
     read_through_openmesh(path, importer);
     check_declared_counts(path, ext, importer, mesh);
@@ -230,11 +231,16 @@ Mesh read_mesh(const std::string& path) {
 void write_mesh(const Mesh& mesh, const std::string& path) {
   const std::string ext = extension_of(path);
   std::function<void(std::ostream&)> writer;
-  if (ext == "obj") writer = [&](std::ostream& out) { write_obj(mesh, out); };
-  else if (ext == "off") writer = [&](std::ostream& out) { write_off(mesh, out); };
-  else if (ext == "ply") writer = [&](std::ostream& out) { write_ply(mesh, out); };
-  else if (ext == "stl") writer = [&](std::ostream& out) { write_stl(mesh, out); };
-  else throw InputError(path + ": unknown mesh format '" + ext + "' (expected .obj, .ply, .off or .stl)");
+  if (ext == "obj")
+    writer = [&](std::ostream& out) { write_obj(mesh, out); };
+  else if (ext == "off")
+    writer = [&](std::ostream& out) { write_off(mesh, out); };
+  else if (ext == "ply")
+    writer = [&](std::ostream& out) { write_ply(mesh, out); };
+  else if (ext == "stl")
+    writer = [&](std::ostream& out) { write_stl(mesh, out); };
+  else
+    throw InputError(path + ": unknown mesh format '" + ext + "' (expected .obj, .ply, .off or .stl)");
   write_file_atomically(path, writer, true);
 }
 

@@ -1,12 +1,12 @@
 #include "datasets/obj_reader.h"
 
-#include "datasets/io_util.h"
-
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <string_view>
 #include <vector>
+
+#include "datasets/io_util.h"
 
 namespace ab {
 namespace {
@@ -46,12 +46,15 @@ uint32_t corner_index(std::string_view token, size_t vertices, size_t face, cons
   return static_cast<uint32_t>(resolved);
 }
 
-void read_face(std::string_view rest, Mesh& mesh, size_t face, std::vector<uint32_t>& corners, const Where& w) {
+void read_face(std::string_view rest, Mesh& mesh, size_t face, std::vector<uint32_t>& corners,
+               const Where& w) {
   corners.clear();
   for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest))
     corners.push_back(corner_index(token, mesh.vertices.size(), face, w));
-  if (corners.size() < 3) throw InputError(w.at() + "face " + std::to_string(face) + " has fewer than three vertices");
-  for (size_t i = 2; i < corners.size(); ++i) mesh.triangles.emplace_back(corners[0], corners[i - 1], corners[i]);
+  if (corners.size() < 3)
+    throw InputError(w.at() + "face " + std::to_string(face) + " has fewer than three vertices");
+  for (size_t i = 2; i < corners.size(); ++i)
+    mesh.triangles.emplace_back(corners[0], corners[i - 1], corners[i]);
 }
 
 }  // namespace
@@ -67,8 +70,10 @@ Mesh read_obj(const std::string& path) {
     std::string_view rest(text);
     rest = rest.substr(0, rest.find('#'));
     const std::string_view keyword = next_token(rest);
-    if (keyword == "v") read_vertex(rest, mesh, w);
-    else if (keyword == "f") read_face(rest, mesh, ++faces, corners, w);
+    if (keyword == "v")
+      read_vertex(rest, mesh, w);
+    else if (keyword == "f")
+      read_face(rest, mesh, ++faces, corners, w);
   }
   if (in.bad()) throw InputError(path + ": read error");
   return mesh;

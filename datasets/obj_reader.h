@@ -2,9 +2,9 @@
 // faces left with fewer than three (and skips vertex lines it cannot parse), which shifts ids.
 #pragma once
 
-#include "accel/mesh.h"
-
 #include <string>
+
+#include "accel/mesh.h"
 
 namespace ab {
 

@@ -2,10 +2,9 @@
 // with every compiler and standard library (no std:: distributions, whose output is unspecified).
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 
 namespace ab {
 
@@ -38,7 +37,9 @@ class Rng {
   /// Uniform float in [lo, hi).
   float uniform(float lo, float hi) { return lo + (hi - lo) * uniform(); }
   /// Uniform integer in [0, n) for n >= 1 (multiply-shift; the bias is below 2^-32 for n < 2^32).
-  uint64_t below(uint64_t n) { return static_cast<uint64_t>((static_cast<unsigned __int128>(next_u64()) * n) >> 64); }
+  uint64_t below(uint64_t n) {
+    return static_cast<uint64_t>((static_cast<unsigned __int128>(next_u64()) * n) >> 64);
+  }
   /// Uniform point in the unit cube [0, 1)^3.
   glm::vec3 unit_cube() {
     const float x = uniform();

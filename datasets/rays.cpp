@@ -1,10 +1,10 @@
 #include "datasets/rays.h"
 
-#include "accel/error.h"
-#include "datasets/random.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "accel/error.h"
+#include "datasets/random.h"
 
 namespace ab {
 namespace {
@@ -96,7 +96,8 @@ SurfacePoint fallback_point(const Frame& f, const Ray& ray) {
 
 /// `count` surface points seen from the primary camera: slot i uses primary ray i; slots whose
 /// ray misses retry with fresh random pixels for a few rounds, then fall back to fallback_point.
-std::vector<SurfacePoint> surface_points(const RayTarget& target, const Frame& f, uint64_t count, uint64_t seed) {
+std::vector<SurfacePoint> surface_points(const RayTarget& target, const Frame& f, uint64_t count,
+                                         uint64_t seed) {
   const Camera camera(f, count);
   std::vector<SurfacePoint> points(count);
   std::vector<uint64_t> pending(count);
@@ -118,9 +119,12 @@ std::vector<SurfacePoint> surface_points(const RayTarget& target, const Frame& f
     }
     size_t kept = 0;
     for (size_t k = 0; k < pending.size(); ++k) {
-      if (hits[k].found()) points[pending[k]] = surface_at(target, rays[k], hits[k]);
-      else if (last) points[pending[k]] = fallback_point(f, rays[k]);
-      else pending[kept++] = pending[k];
+      if (hits[k].found())
+        points[pending[k]] = surface_at(target, rays[k], hits[k]);
+      else if (last)
+        points[pending[k]] = fallback_point(f, rays[k]);
+      else
+        pending[kept++] = pending[k];
     }
     pending.resize(last ? 0 : kept);
   }
@@ -207,7 +211,8 @@ const std::vector<RayKindInfo>& ray_kinds() {
       {"incoherent", "random origin inside the bounds, uniform random direction"},
       {"shadow", "from primary hit points to a point light above the bounds (finite tmax)"},
       {"diffuse", "cosine-weighted bounce from primary hit points"},
-      {"ao", "short ambient-occlusion rays over the hemisphere at primary hit points (tmax 10% of the diagonal)"},
+      {"ao",
+       "short ambient-occlusion rays over the hemisphere at primary hit points (tmax 10% of the diagonal)"},
   };
   return kinds;
 }

@@ -1,7 +1,5 @@
 #include "datasets/stl_io.h"
 
-#include "datasets/io_util.h"
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -9,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 #include <vector>
+
+#include "datasets/io_util.h"
 
 namespace ab {
 namespace {
@@ -52,8 +52,10 @@ Mesh read_stl_ascii(const std::string& path, std::istream& in) {
       in_loop = 0;
     } else if (word == "vertex") {
       std::string x, y, z;
-      if (!looping || !(words >> x >> y >> z)) throw InputError(path + ":" + std::to_string(line) + ": bad vertex line");
-      mesh.vertices.emplace_back(parse_float(x, path, line), parse_float(y, path, line), parse_float(z, path, line));
+      if (!looping || !(words >> x >> y >> z))
+        throw InputError(path + ":" + std::to_string(line) + ": bad vertex line");
+      mesh.vertices.emplace_back(parse_float(x, path, line), parse_float(y, path, line),
+                                 parse_float(z, path, line));
       ++in_loop;
     } else if (word == "endloop") {
       if (!looping || in_loop != 3)

@@ -2,10 +2,10 @@
 // positions and drops triangles whose merged corners coincide, which would shift triangle ids.
 #pragma once
 
-#include "accel/mesh.h"
-
 #include <ostream>
 #include <string>
+
+#include "accel/mesh.h"
 
 namespace ab {
 

@@ -1,14 +1,14 @@
 // Mesh generators: deterministic by seed, the target triangle count, finite geometry, parameters.
 #include "datasets/generators.h"
 
-#include "accel/error.h"
-
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <map>
 #include <set>
+
+#include "accel/error.h"
 
 namespace ab {
 namespace {
@@ -25,9 +25,13 @@ void expect_valid(const Mesh& m, const std::string& name) {
 }
 
 /// Parameters from key/value pairs.
-Params with(std::map<std::string, std::string> values) { return Params(std::move(values)); }
+Params with(std::map<std::string, std::string> values) {
+  return Params(std::move(values));
+}
 
-bool same_mesh(const Mesh& a, const Mesh& b) { return a.vertices == b.vertices && a.triangles == b.triangles; }
+bool same_mesh(const Mesh& a, const Mesh& b) {
+  return a.vertices == b.vertices && a.triangles == b.triangles;
+}
 
 TEST(Generators, ListHasTheRequiredNamesWithDescriptions) {
   std::set<std::string> names;
@@ -45,7 +49,8 @@ TEST(Generators, TriangleCountMatchesTheTarget) {
       const Mesh m = generate_mesh(g.name, n, 1, Params());
       SCOPED_TRACE(g.name + " " + std::to_string(n));
       EXPECT_GE(m.size(), 1u);
-      EXPECT_LE(std::fabs(static_cast<double>(m.size()) - static_cast<double>(n)), 0.02 * static_cast<double>(n));
+      EXPECT_LE(std::fabs(static_cast<double>(m.size()) - static_cast<double>(n)),
+                0.02 * static_cast<double>(n));
       expect_valid(m, g.name);
     }
 }
@@ -102,7 +107,8 @@ TEST(Generators, CityscapeHasLatticeCoordinatesDuplicatesAndDegenerates) {
   for (size_t i = 0; i < m.size(); ++i) {
     const Triangle t = m.triangle(i);
     if (glm::cross(t.v1 - t.v0, t.v2 - t.v0) == vec3(0.0f)) ++zero_area;
-    duplicates += !seen.insert({t.v0.x, t.v0.y, t.v0.z, t.v1.x, t.v1.y, t.v1.z, t.v2.x, t.v2.y, t.v2.z}).second;
+    duplicates +=
+        !seen.insert({t.v0.x, t.v0.y, t.v0.z, t.v1.x, t.v1.y, t.v1.z, t.v2.x, t.v2.y, t.v2.z}).second;
   }
   EXPECT_GT(zero_area, 0u);
   EXPECT_GT(duplicates, 0u);

@@ -1,18 +1,18 @@
 // Mesh I/O: the contract's id rule (file face order, fan triangulation, every face kept) for every
 // format, round trips, the real meshes, and bad files.
-#include "datasets/generators.h"
 #include "datasets/mesh_io.h"
 
-#include "accel/error.h"
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
+
+#include "accel/error.h"
+#include "datasets/generators.h"
 
 namespace ab {
 namespace {
@@ -23,9 +23,8 @@ namespace fs = std::filesystem;
 class MeshIoTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("accelbench_mesh_io_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("accelbench_mesh_io_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -39,7 +38,7 @@ class MeshIoTest : public ::testing::Test {
 
 // The test polygon soup: a quad, a pentagon, three more faces on edge (0,1) (non-manifold), a
 // duplicated face and a degenerate face (repeated vertex).
-const std::vector<vec3> kVertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0},    {0, 1, 0},
+const std::vector<vec3> kVertices = {{0, 0, 0},    {1, 0, 0},       {1, 1, 0},    {0, 1, 0},
                                      {2, 0.5f, 0}, {1.5f, 2, 0.1f}, {0.5f, 1, 1}, {0.25f, -1, 0.75f}};
 const std::vector<std::vector<int>> kFaces = {{0, 1, 2, 3}, {0, 1, 4, 5, 6}, {0, 1, 5}, {0, 1, 6},
                                               {0, 1, 7},    {2, 3, 4},       {2, 3, 4}, {1, 1, 2}};
@@ -97,7 +96,8 @@ void put4(std::string& s, T value, bool big) {
 }
 
 std::string ply_binary_text(bool big) {
-  std::string s = ply_header(big ? "binary_big_endian" : "binary_little_endian", kVertices.size(), kFaces.size());
+  std::string s =
+      ply_header(big ? "binary_big_endian" : "binary_little_endian", kVertices.size(), kFaces.size());
   for (const vec3& v : kVertices) {
     put4(s, v.x, big);
     put4(s, v.y, big);
@@ -115,7 +115,8 @@ std::string stl_ascii_text() {
   s << "solid test\n";
   for (const glm::uvec3& t : kTriangles) {
     s << "  facet normal 0 0 1\n    outer loop\n";
-    for (uint32_t i : {t.x, t.y, t.z}) s << "      vertex " << kVertices[i].x << ' ' << kVertices[i].y << ' ' << kVertices[i].z << '\n';
+    for (uint32_t i : {t.x, t.y, t.z})
+      s << "      vertex " << kVertices[i].x << ' ' << kVertices[i].y << ' ' << kVertices[i].z << '\n';
     s << "    endloop\n  endfacet\n";
   }
   s << "endsolid test\n";
@@ -158,7 +159,9 @@ Mesh soup_mesh() {
   return m;
 }
 
-TEST_F(MeshIoTest, ObjKeepsFaceOrderFansAndEveryFace) { expect_indexed(read_mesh(write("a.obj", obj_text()))); }
+TEST_F(MeshIoTest, ObjKeepsFaceOrderFansAndEveryFace) {
+  expect_indexed(read_mesh(write("a.obj", obj_text())));
+}
 TEST_F(MeshIoTest, ObjCornerFormsNegativeIndicesAndRepeatedCorners) {
   // i/t/n and i//n corners, negative (relative) indices, and a quad with a repeated corner, which
   // must still give two triangles in fan order (OpenMesh's OBJ reader would merge the corners).
@@ -170,7 +173,9 @@ TEST_F(MeshIoTest, ObjCornerFormsNegativeIndicesAndRepeatedCorners) {
   EXPECT_EQ(m.triangles, expected);
   EXPECT_EQ(m.vertices.size(), 4u);
 }
-TEST_F(MeshIoTest, OffKeepsFaceOrderFansAndEveryFace) { expect_indexed(read_mesh(write("a.off", off_text()))); }
+TEST_F(MeshIoTest, OffKeepsFaceOrderFansAndEveryFace) {
+  expect_indexed(read_mesh(write("a.off", off_text())));
+}
 TEST_F(MeshIoTest, AsciiPlyKeepsFaceOrderFansAndEveryFace) {
   expect_indexed(read_mesh(write("a.ply", ply_ascii_text())));
 }
@@ -215,7 +220,8 @@ TEST_F(MeshIoTest, WritingIsByteDeterministicAndLeavesNoTemporaryFile) {
     write_mesh(m, a);
     write_mesh(m, b);
     std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
-    const std::string ca((std::istreambuf_iterator<char>(fa)), {}), cb((std::istreambuf_iterator<char>(fb)), {});
+    const std::string ca((std::istreambuf_iterator<char>(fa)), {}),
+        cb((std::istreambuf_iterator<char>(fb)), {});
     EXPECT_FALSE(ca.empty());
     EXPECT_EQ(ca, cb) << ext;
   }
@@ -265,16 +271,19 @@ TEST_F(MeshIoTest, NonFiniteCoordinates) {
   expect_input_error(write("nan.ply", ply), "NaN or infinite");
   expect_input_error(write("nan2.ply", ply_header("ascii", 3, 1) + "0 0 0\nnan 1 0\n0 1 0\n3 0 1 2\n"),
                      "NaN or infinite");
-  expect_input_error(write("nan.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n"
-                                      "vertex 0 1 0\nendloop\nendfacet\nendsolid x\n"),
+  expect_input_error(write("nan.stl",
+                           "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n"
+                           "vertex 0 1 0\nendloop\nendfacet\nendsolid x\n"),
                      "NaN or infinite");
 }
 
 TEST_F(MeshIoTest, IndexOutOfRange) {
   expect_input_error(write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n"), "vertex");
   expect_input_error(write("bad.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 7\n"), "vertex");
-  expect_input_error(write("bad.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "vertex");
-  expect_input_error(write("neg.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"), "vertex -1");
+  expect_input_error(write("bad.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
+                     "vertex");
+  expect_input_error(write("neg.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"),
+                     "vertex -1");
   std::string binary = ply_binary_text(false);
   binary[binary.size() - 1] = 0x7F;  // last corner of the last face becomes a huge index
   expect_input_error(write("bad_binary.ply", binary), "vertex");
@@ -292,11 +301,15 @@ TEST_F(MeshIoTest, TruncatedBinaryFiles) {
 
 TEST_F(MeshIoTest, MalformedContent) {
   expect_input_error(write("m.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"), "truncated");
-  expect_input_error(write("m.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n"), "not a number");
-  expect_input_error(write("m.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"), "end_header");
-  expect_input_error(write("n.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n"),
-                     "x, y or z");
-  expect_input_error(write("p.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"), "not a number");
+  expect_input_error(write("m.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n"),
+                     "not a number");
+  expect_input_error(write("m.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"),
+                     "end_header");
+  expect_input_error(
+      write("n.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n"),
+      "x, y or z");
+  expect_input_error(write("p.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"),
+                     "not a number");
   expect_input_error(write("q.ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n"), "truncated");
   expect_input_error(write("r.ply", "PLY?\n"), "not a PLY file");
   expect_input_error(write("m.obj", "v 0 0\n"), "three coordinates");
@@ -314,8 +327,12 @@ void expect_real_mesh(const std::string& name, size_t faces) {
   EXPECT_FALSE(m.bounds().empty());
 }
 
-TEST(MeshIoRealMeshes, StanfordBunny) { expect_real_mesh("stanford-bunny.obj", 69451); }
-TEST(MeshIoRealMeshes, Teapot) { expect_real_mesh("teapot.obj", 6320); }
+TEST(MeshIoRealMeshes, StanfordBunny) {
+  expect_real_mesh("stanford-bunny.obj", 69451);
+}
+TEST(MeshIoRealMeshes, Teapot) {
+  expect_real_mesh("teapot.obj", 6320);
+}
 
 }  // namespace
 }  // namespace ab

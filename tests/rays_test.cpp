@@ -1,15 +1,15 @@
 // Ray sets: exact counts, determinism, finite values, and what each kind promises.
 #include "datasets/rays.h"
 
-#include "accel/error.h"
-#include "accel/registry.h"
-#include "datasets/generators.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 #include <memory>
+
+#include "accel/error.h"
+#include "accel/registry.h"
+#include "datasets/generators.h"
 
 namespace ab {
 namespace {
@@ -36,7 +36,9 @@ bool same_bytes(const std::vector<Ray>& a, const std::vector<Ray>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Ray)) == 0;
 }
 
-bool finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 class RaysTest : public ::testing::Test {
  protected:
@@ -60,7 +62,8 @@ TEST_F(RaysTest, EveryKindExactCountFiniteAndDeterministic) {
         ASSERT_GE(r.tmin, 0.0f);
       }
     }
-    EXPECT_FALSE(same_bytes(make_rays(kind.name, flake_->target, 100, 1), make_rays(kind.name, flake_->target, 100, 2)));
+    EXPECT_FALSE(same_bytes(make_rays(kind.name, flake_->target, 100, 1),
+                            make_rays(kind.name, flake_->target, 100, 2)));
   }
 }
 
