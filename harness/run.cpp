@@ -418,8 +418,11 @@ Timing Runner::time_query(const std::string& name, size_t rays, const std::funct
     work();
     return seconds_since(t0);
   };
-  double estimate = 0.0;
-  for (int i = 0; i < suite_.warmup; ++i) estimate = pass();
+  double estimate = 0.0;  // the fastest warm-up pass (the least disturbed by other processes)
+  for (int i = 0; i < suite_.warmup; ++i) {
+    const double s = pass();
+    estimate = i == 0 ? s : std::min(estimate, s);
+  }
   const int64_t iterations = estimate > 0 ? iterations_for(estimate, suite_.min_time) : 1;
   return timer_.time(name, suite_.repetitions, iterations, pass, double(rays));
 }

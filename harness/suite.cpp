@@ -327,7 +327,7 @@ constexpr const char* kDefaultSuiteJson = R"json({
   "repetitions": 5,
   "build_repetitions": 3,
   "warmup": 1,
-  "min_time": 0.01,
+  "min_time": 0.05,
   "threads": [1, 0],
   "scenes": [
     {"generator": "sphereflake", "triangles": [10000, 100000], "seed": 1},
