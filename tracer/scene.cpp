@@ -43,6 +43,7 @@ class SceneParser {
     for (pugi::xml_node n : root.children()) declaration(n);
     for (pugi::xml_node n : root.children("instance")) instance(n);
     if (scene_.instances.empty()) fail(root, "the scene has no <instance>");
+    scene_.bounds = scene_.compute_world_bounds();
     return std::move(scene_);
   }
 
@@ -466,6 +467,10 @@ uint64_t Scene::triangle_count() const {
 }
 
 AABB Scene::world_bounds() const {
+  return bounds.empty() ? compute_world_bounds() : bounds;
+}
+
+AABB Scene::compute_world_bounds() const {
   AABB b;
   for (const SceneInstance& inst : instances) {
     const Mesh& m = *meshes[inst.mesh].mesh;

@@ -52,8 +52,12 @@ struct Scene {
 
   /// World-space triangles over all instances.
   uint64_t triangle_count() const;
-  /// World bounds of all instances (transformed mesh vertices).
+  AABB bounds;  ///< world bounds, filled by the parser (empty: world_bounds() computes them)
+
+  /// World bounds of all instances (their transformed mesh vertices).
   AABB world_bounds() const;
+  /// Computes the world bounds from the instances (every transformed vertex).
+  AABB compute_world_bounds() const;
   /// World-space geometric normal (unnormalized, by the inverse transpose) of a hit.
   vec3 hit_normal(const Hit& hit) const;
 };
