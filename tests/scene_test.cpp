@@ -402,5 +402,27 @@ TEST(Scene, CliFlattenAndRaysWork) {
   fs::remove_all(dir);
 }
 
+TEST(Scene, CliRendersTheSamePngForAnyThreadCount) {
+  const char* bin = std::getenv("ACCELBENCH_BIN");
+  if (!fs::exists(bin ? bin : "build/accelbench")) GTEST_SKIP() << "accelbench binary not found";
+  const fs::path dir = fs::temp_directory_path() / ("accelbench_scene_png_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path scene = dir / "s.xml";
+  std::ofstream(scene) << instanced_scene_xml(20);
+  const std::string base =
+      "render --scene " + scene.string() + " --width 40 --height 30 --spp 4 --accel brute";
+  EXPECT_EQ(run_cli(base + " --threads 1 -o " + (dir / "a.png").string(), dir).first, 0);
+  EXPECT_EQ(run_cli(base + " --threads 2 -o " + (dir / "b.png").string(), dir).first, 0);
+  EXPECT_EQ(run_cli(base + " --heatmap -o " + (dir / "h.png").string(), dir).first, 0);
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_FALSE(bytes(dir / "a.png").empty());
+  EXPECT_EQ(bytes(dir / "a.png"), bytes(dir / "b.png"));
+  EXPECT_TRUE(fs::exists(dir / "h.png"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace ab
