@@ -22,7 +22,7 @@ namespace ab {
 
 /// Grid settings.
 struct GridConfig {
-  double lambda = 1.5;              ///< density: about lambda * cbrt(N) cells per axis for a cube (lambda^3 N cells)
+  double lambda = 1.0;              ///< density: about lambda * cbrt(N) cells per axis for a cube (lambda^3 N cells)
   uint64_t max_cells = 1ull << 24;  ///< cap on the number of cells
 };
 
