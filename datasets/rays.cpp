@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "accel/error.h"
 #include "datasets/random.h"
@@ -94,10 +95,14 @@ SurfacePoint fallback_point(const Frame& f, const Ray& ray) {
   return {ray.org + glm::dot(f.center - ray.org, ray.dir) * ray.dir, -ray.dir};
 }
 
+/// Which surface points a kind can use (shadow: those facing the light); empty accepts all.
+using Accept = std::function<bool(const SurfacePoint&)>;
+
 /// `count` surface points seen from the primary camera: slot i uses primary ray i; slots whose
-/// ray misses retry with fresh random pixels for a few rounds, then fall back to fallback_point.
+/// ray misses (or whose point `accept` rejects) retry with fresh random pixels for a few rounds,
+/// then fall back to fallback_point.
 std::vector<SurfacePoint> surface_points(const RayTarget& target, const Frame& f, uint64_t count,
-                                         uint64_t seed) {
+                                         uint64_t seed, const Accept& accept) {
   const Camera camera(f, count);
   std::vector<SurfacePoint> points(count);
   std::vector<uint64_t> pending(count);
@@ -119,8 +124,9 @@ std::vector<SurfacePoint> surface_points(const RayTarget& target, const Frame& f
     }
     size_t kept = 0;
     for (size_t k = 0; k < pending.size(); ++k) {
-      if (hits[k].found())
-        points[pending[k]] = surface_at(target, rays[k], hits[k]);
+      const SurfacePoint s = hits[k].found() ? surface_at(target, rays[k], hits[k]) : SurfacePoint{};
+      if (hits[k].found() && (!accept || accept(s) || last))
+        points[pending[k]] = s;
       else if (last)
         points[pending[k]] = fallback_point(f, rays[k]);
       else
@@ -187,8 +193,8 @@ std::vector<Ray> incoherent_rays(const Frame& f, uint64_t count, uint64_t seed) 
 /// Secondary rays from surface points; `make` turns (point, its rng) into the direction and tmax.
 template <class Make>
 std::vector<Ray> secondary_rays(const RayTarget& target, const Frame& f, uint64_t count, uint64_t seed,
-                                uint64_t kind, Make make) {
-  const std::vector<SurfacePoint> points = surface_points(target, f, count, seed);
+                                uint64_t kind, const Accept& accept, Make make) {
+  const std::vector<SurfacePoint> points = surface_points(target, f, count, seed, accept);
   std::vector<Ray> rays(count);
   for (uint64_t i = 0; i < count; ++i) {
     Rng rng = ray_rng(seed, kind, i);
@@ -223,7 +229,12 @@ std::vector<Ray> make_rays(const std::string& kind, const RayTarget& target, uin
   if (kind == "incoherent") return incoherent_rays(f, count, seed);
   if (kind == "shadow") {
     const vec3 light(f.center.x + 0.2f * f.diag, f.box.hi.y + 0.5f * f.diag, f.center.z + 0.1f * f.diag);
-    return secondary_rays(target, f, count, seed, 3, [&](const SurfacePoint&, Rng&, Ray& r) {
+    // Like a renderer, only points lit from their front get shadow rays (a ray through the surface
+    // it starts on would end at once); the others are replaced by retries.
+    const Accept faces_light = [&](const SurfacePoint& s) {
+      return glm::dot(s.normal, light - s.pos) > 0.0f;
+    };
+    return secondary_rays(target, f, count, seed, 3, faces_light, [&](const SurfacePoint&, Rng&, Ray& r) {
       const vec3 to_light = light - r.org;
       const float distance = glm::length(to_light);
       r.dir = distance > 0.0f ? to_light / distance : vec3(0.0f, 1.0f, 0.0f);
@@ -231,13 +242,13 @@ std::vector<Ray> make_rays(const std::string& kind, const RayTarget& target, uin
     });
   }
   if (kind == "diffuse")
-    return secondary_rays(target, f, count, seed, 4, [](const SurfacePoint& s, Rng& rng, Ray& r) {
+    return secondary_rays(target, f, count, seed, 4, Accept(), [](const SurfacePoint& s, Rng& rng, Ray& r) {
       r.dir = around(s.normal, cosine_direction(rng));
       r.tmax = kInf;
     });
   if (kind == "ao") {
     const float reach = 0.1f * f.diag;
-    return secondary_rays(target, f, count, seed, 5, [&](const SurfacePoint& s, Rng& rng, Ray& r) {
+    return secondary_rays(target, f, count, seed, 5, Accept(), [&](const SurfacePoint& s, Rng& rng, Ray& r) {
       r.dir = around(s.normal, hemisphere_direction(rng));
       r.tmax = reach;
     });
