@@ -124,9 +124,9 @@ struct BvhPairTest {
     tr = entry(pair[1], limit);
   }
 
-  RayBoxData rd;
-  float tmin;
-  int near_index[3], far_index[3];
+  RayBoxData rd;                      ///< origin, reciprocal direction, sign bits
+  float tmin;                         ///< the ray's tmin (lower clip of every entry)
+  int near_index[3], far_index[3];    ///< float index in a node of the near and far plane per axis
 };
 
 /// A BVH over primitive set P built by `M`. For triangles the vertices are copied into leaf order
