@@ -387,7 +387,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   }
 
   /// One interior node: the plane step with a band that covers the rounding of n.o - d and the margin.
-  bool step(const BspNode& n, StackItem& cur, const Ray& ray, const vec3& abs_org, StackItem* stack, int& sp) const {
+  [[gnu::always_inline]] bool step(const BspNode& n, StackItem& cur, const Ray& ray, const vec3& abs_org, StackItem* stack, int& sp) const {
     const BspPlane& p = planes_[n.first()];
     const float org_dist = p.distance(ray.org);
     const float rate = glm::dot(p.n, ray.dir);
@@ -409,7 +409,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
     return false;
   }
 
-  static bool pop(const StackItem* stack, int& sp, float best_t, StackItem& cur) {
+  [[gnu::always_inline]] static bool pop(const StackItem* stack, int& sp, float best_t, StackItem& cur) {
     while (sp > 0) {
       const StackItem& it = stack[--sp];
       if (it.t0 > best_t) continue;

@@ -1,6 +1,7 @@
 // The traditional k-d tree build (Bentley 1975; the spatial-median k-d tree of the ray-tracing lectures):
 // each node splits at the median of its primitives' centres along its longest axis (or the axes in turn),
-// until a leaf holds at most leaf_size primitives or the depth limit is reached. Primitives are tracked by
+// until a leaf holds at most leaf_size primitives, the depth limit is reached, or most primitives would
+// straddle the plane (then splitting only duplicates them). Primitives are tracked by
 // their perfect-split bounds inside the node box, and the partition is conservative: a primitive that
 // touches the plane or comes within the insertion margin of it goes to both children.
 #pragma once
@@ -56,7 +57,7 @@ class KdMedianBuilder {
     lbox.hi[axis] = split;
     rbox.lo[axis] = split;
     partition(refs, axis, split, insertion_margin(box), lbox, rbox, left, right);
-    if (left.size() == n && right.size() == n) {
+    if (left.size() + right.size() > n + n * 3 / 4) {  // most primitives straddle: splitting no longer pays
       make_leaf(refs, out);
       return;
     }

@@ -50,7 +50,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
     for (uint32_t i : unbounded_) prims_->template intersect<kCount>(i, ray, best, inst, c);
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return;
-    const vec3 inv(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
+    const RayAxes axes(ray);
     StackItem stack[kStackSize];
     int sp = 0;
     uint32_t node = 0;
@@ -58,7 +58,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       const KdNode& n = nodes_[node];
       if constexpr (kCount) ++c.nodes;
       if (!n.is_leaf()) {
-        if (step(n, node, ray, inv, t0, t1, stack, sp)) continue;
+        if (step(n, node, axes, t0, t1, stack, sp)) continue;
       } else {
         if constexpr (kCount) ++c.leaves;
         r.tmax = std::min(ray.tmax, best.t);
@@ -77,7 +77,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       if (prims_->template occluded<kCount>(i, ray, c)) return true;
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
-    const vec3 inv(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
+    const RayAxes axes(ray);
     StackItem stack[kStackSize];
     int sp = 0;
     uint32_t node = 0;
@@ -85,7 +85,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       const KdNode& n = nodes_[node];
       if constexpr (kCount) ++c.nodes;
       if (!n.is_leaf()) {
-        if (step(n, node, ray, inv, t0, t1, stack, sp)) continue;
+        if (step(n, node, axes, t0, t1, stack, sp)) continue;
       } else {
         if constexpr (kCount) ++c.leaves;
         const uint32_t* ids = &prims_ids_[n.first()];
@@ -140,10 +140,10 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
 
   /// One interior node: continues into the first child met (pushing the second) and returns true, or
   /// returns false when neither child overlaps the interval.
-  bool step(const KdNode& n, uint32_t& node, const Ray& ray, const vec3& inv, float& t0, float& t1,
-            StackItem* stack, int& sp) const {
+  [[gnu::always_inline]] bool step(const KdNode& n, uint32_t& node, const RayAxes& r, float& t0, float& t1, StackItem* stack,
+            int& sp) const {
     const int a = n.axis();
-    const PlaneVisit v = split_at_axis_plane(ray.org[a], ray.dir[a], inv[a], n.split(), t0, t1);
+    const PlaneVisit v = split_at_axis_plane(r.org[a], r.dir[a], r.inv[a], n.split(), t0, t1);
     const uint32_t first = v.first_below ? node + 1 : n.above();
     const uint32_t second = v.first_below ? n.above() : node + 1;
     if (v.visit_first) {
@@ -161,7 +161,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   }
 
   /// Next node from the stack whose entry is not beyond best_t (strictly); false when none is left.
-  static bool pop(const StackItem* stack, int& sp, float best_t, uint32_t& node, float& t0, float& t1) {
+  [[gnu::always_inline]] static bool pop(const StackItem* stack, int& sp, float best_t, uint32_t& node, float& t0, float& t1) {
     while (sp > 0) {
       const StackItem& it = stack[--sp];
       if (it.t0 > best_t) continue;

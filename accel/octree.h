@@ -165,7 +165,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || box_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
-    const vec3 inv(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
+    const RayAxes axes(ray);
     Cell stack[kStackSize];
     int sp = 0;
     Cell cur{0, 0, 0, t0, t1, box_};
@@ -179,7 +179,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
         cur = {n.first() + uint32_t(cur.octant), 0, 0, cur.t0, cur.t1, cur.box};
         if constexpr (kCount) ++c.nodes;
         continue;
-      } else if (split_cell(cur, ray, inv, stack, sp)) {
+      } else if (split_cell(cur, axes, stack, sp)) {
         continue;
       }
       if (!pop(stack, sp, best_t(), cur)) return false;
@@ -187,10 +187,10 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   }
 
   /// Splits the current cell at its mid-plane of axis cur.level; continues into the first half met.
-  static bool split_cell(Cell& cur, const Ray& ray, const vec3& inv, Cell* stack, int& sp) {
+  [[gnu::always_inline]] static bool split_cell(Cell& cur, const RayAxes& r, Cell* stack, int& sp) {
     const int a = cur.level;
     const float mid = 0.5f * (cur.box.lo[a] + cur.box.hi[a]);
-    const PlaneVisit v = split_at_axis_plane(ray.org[a], ray.dir[a], inv[a], mid, cur.t0, cur.t1);
+    const PlaneVisit v = split_at_axis_plane(r.org[a], r.dir[a], r.inv[a], mid, cur.t0, cur.t1);
     Cell below = cur, above = cur;
     below.level = above.level = a + 1;
     below.box.hi[a] = mid;
@@ -207,7 +207,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
     return true;
   }
 
-  static bool pop(const Cell* stack, int& sp, float best_t, Cell& cur) {
+  [[gnu::always_inline]] static bool pop(const Cell* stack, int& sp, float best_t, Cell& cur) {
     while (sp > 0) {
       const Cell& it = stack[--sp];
       if (it.t0 > best_t) continue;

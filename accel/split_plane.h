@@ -29,7 +29,7 @@ struct PlaneVisit {
 /// the below side), the rate of change of that distance along the ray (`rate`, the direction's component
 /// along the normal), t_split and the half-width `widen` of the uncertain band around t_split.
 /// `in_plane_band` is how close to the plane a parallel ray counts as lying in it.
-inline PlaneVisit split_interval(float org_dist, float rate, float t_split, float widen, float in_plane_band,
+[[gnu::always_inline]] inline PlaneVisit split_interval(float org_dist, float rate, float t_split, float widen, float in_plane_band,
                                  float t0, float t1) {
   PlaneVisit v;
   if (rate == 0.0f || t_split != t_split) {
@@ -48,9 +48,21 @@ inline PlaneVisit split_interval(float org_dist, float rate, float t_split, floa
   return v;
 }
 
+/// A ray's origin, direction and reciprocal direction as plain arrays (indexing a glm vector by a
+/// run-time axis goes through a switch).
+struct RayAxes {
+  float org[3], dir[3], inv[3];
+
+  /// From ray r.
+  explicit RayAxes(const Ray& r)
+      : org{r.org.x, r.org.y, r.org.z},
+        dir{r.dir.x, r.dir.y, r.dir.z},
+        inv{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z} {}
+};
+
 /// The axis-aligned case (k-d trees, octree): plane coordinate `split` on an axis where the ray has
 /// origin `org`, direction `dir` and reciprocal `inv`. The band is relative (kBoxEps), as in slab_test.
-inline PlaneVisit split_at_axis_plane(float org, float dir, float inv, float split, float t0, float t1) {
+[[gnu::always_inline]] inline PlaneVisit split_at_axis_plane(float org, float dir, float inv, float split, float t0, float t1) {
   const float t_split = (split - org) * inv;
   return split_interval(org - split, dir, t_split, std::fabs(t_split) * kBoxEps, 0.0f, t0, t1);
 }
