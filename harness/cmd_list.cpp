@@ -3,6 +3,7 @@
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/cli.h"
+#include "tracer/workload.h"
 
 #include <nlohmann/json.hpp>
 
@@ -27,6 +28,9 @@ nlohmann::json listing() {
   for (const auto& g : generators()) j["generators"].push_back({{"name", g.name}, {"description", g.description}});
   j["ray_kinds"] = nlohmann::json::array();
   for (const auto& k : ray_kinds()) j["ray_kinds"].push_back({{"name", k.name}, {"description", k.description}});
+  j["scene_ray_kinds"] = nlohmann::json::array();
+  for (const auto& k : scene_ray_kinds())
+    j["scene_ray_kinds"].push_back({{"name", k.name}, {"description", k.description}});
   return j;
 }
 
@@ -49,6 +53,7 @@ const CommandRegistrar kList{{"list", "names of accelerators, mesh generators an
                                     print_section("accelerators", j["accelerators"]);
                                     print_section("generators", j["generators"]);
                                     print_section("ray kinds", j["ray_kinds"]);
+                                    print_section("ray kinds for --scene (the tracer's own)", j["scene_ray_kinds"]);
                                   }
                                   return 0;
                                 };

@@ -57,7 +57,7 @@ int run_verify(const VerifyArgs& a) {
   const Target target = load_target(a.target.mesh, a.target.scene);
   std::vector<Ray> rays;
   if (!a.rays.empty()) rays = read_rays(a.rays);
-  else rays = make_rays(a.kind.empty() ? "incoherent" : a.kind, ray_target(target), a.count, a.seed);
+  else rays = make_target_rays(target, a.kind.empty() ? "incoherent" : a.kind, a.count, a.seed);
   const HitTriangleFn triangle_of = hit_triangles(target);
   double embree_build = 0.0;
   const std::vector<Hit> embree = trace_with(target, "embree", rays, a.threads, embree_build);
