@@ -23,6 +23,12 @@ struct Triangle {
 };
 static_assert(sizeof(Triangle) == 36);
 
+/// Relative bound on the rounding of the kernel's denominator (see intersect_triangle).
+inline constexpr float kCoplanarEps = 0x1p-18f;
+
+/// |x| + |y| + |z|.
+inline float l1_norm(const vec3& v) { return std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z); }
+
 /// A candidate intersection produced by the kernel.
 struct TriangleHit {
   float t, u, v;
@@ -30,7 +36,7 @@ struct TriangleHit {
 
 /// Moller and Trumbore 1997, "Fast, minimum storage ray-triangle intersection", written with the
 /// geometric normal n = e1 x e2 (as Embree does) so that a zero-area triangle, whose n is exactly the
-/// zero vector, has a zero denominator and never hits. Single precision, no fused operations
+/// zero vector, has a zero denominator and never hits; nor does a ray lying in the triangle's plane. Single precision, no fused operations
 /// (the build uses -ffp-contract=off), so results are the same bits wherever it is inlined.
 /// Returns true and fills out when tmin <= t <= tmax and the point lies inside or on the triangle;
 /// u and v are the weights of v1 and v2.
@@ -39,7 +45,14 @@ inline bool intersect_triangle(const Ray& ray, const Triangle& tri, TriangleHit&
   const vec3 e2 = tri.v2 - tri.v0;
   const vec3 n = glm::cross(e1, e2);
   const float den = glm::dot(ray.dir, n);
-  if (den == 0.0f || den != den) return false;
+  // A ray lying in the triangle's plane has den = 0 only in exact arithmetic; in floats it is rounding
+  // noise, and num/den then puts a "hit" anywhere along the ray, outside every box that holds the
+  // triangle. So den must exceed a bound on its rounding error (relative kCoplanarEps of the L1 product
+  // of |dir|, |e1|, |e2|), or the ray counts as parallel. The same rule for every structure keeps hits
+  // identical; such rays graze the plane within about 1e-5 radians (Embree's differ: verify calls them
+  // graze cases). Also rejects NaN.
+  const float scale = l1_norm(ray.dir) * l1_norm(e1) * l1_norm(e2);
+  if (!(std::fabs(den) > scale * kCoplanarEps)) return false;
   const float inv = 1.0f / den;
   const vec3 to_origin = ray.org - tri.v0;
   const vec3 c = glm::cross(ray.dir, to_origin);

@@ -122,6 +122,9 @@ std::vector<Ray> adversarial_rays(const Mesh& mesh, const AABB& box, uint64_t se
     rays.push_back({tri.centroid(), rng.unit_sphere(), 0.0f, kInf});  // starting on the surface
     Ray in_plane{tri.v0 - vec3(b.extent().x + 1, 0, 0), vec3(1, 0, 0), 0.0f, kInf};  // in the axis planes of v0
     rays.push_back(in_plane);
+    // Lying in the triangle's own (generally oblique) plane, along an edge direction and across it.
+    rays.push_back({tri.v0 - (tri.v1 - tri.v0), tri.v1 - tri.v0, 0.0f, kInf});
+    rays.push_back({tri.v0 - 0.5f * (tri.v1 + tri.v2 - 2.0f * tri.v0), 0.5f * (tri.v1 + tri.v2) - tri.v0, 0.0f, kInf});
     Ray limited{point(), tri.centroid(), 0.0f, 1.0f};
     limited.dir = tri.centroid() - limited.org;
     rays.push_back(limited);  // tmax exactly at the hit

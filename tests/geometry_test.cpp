@@ -82,6 +82,25 @@ TEST(TriangleKernel, DegenerateTrianglesNeverHit) {
   }
 }
 
+TEST(TriangleKernel, RaysLyingInAnObliquePlaneNeverHit) {
+  // An oblique triangle: its plane is not an axis plane, so den is rounding noise, not exactly 0.
+  const Triangle tri{{0.1f, 0.2f, 0.3f}, {1.7f, 0.9f, -0.4f}, {0.3f, 1.9f, 1.1f}};
+  const vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+  TriangleHit h;
+  int tested = 0;
+  for (float a = -1.0f; a <= 1.0f; a += 0.125f)
+    for (float b = -1.0f; b <= 1.0f; b += 0.25f) {
+      const Ray r{tri.v0 - e1 + a * e2, e1 + b * e2, 0.0f, kInf};  // origin and direction in the plane
+      EXPECT_FALSE(intersect_triangle(r, tri, h)) << a << " " << b << ": t=" << h.t;
+      ++tested;
+    }
+  EXPECT_GT(tested, 100);
+  // A steep ray through the same triangle still hits.
+  const vec3 n = glm::cross(e1, e2);
+  EXPECT_TRUE(intersect_triangle({tri.centroid() + n, -n, 0.0f, kInf}, tri, h));
+  EXPECT_NEAR(h.t, 1.0f, 1e-5f);
+}
+
 TEST(AcceptanceRule, CloserThenLowerInstanceThenLowerPrim) {
   Hit best{1.0f, 5, 2, 0, 0};
   EXPECT_TRUE(is_better_hit(0.5f, 9, 9, best));
