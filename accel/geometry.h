@@ -111,7 +111,7 @@ struct RayBoxData {
 /// behind the origin widen too, and by more than that bound so that a triangle whose kernel t lies a
 /// few ulps outside its box's computed interval (flat geometry on a box face) is never culled or
 /// passed over in a tie.
-inline constexpr float kBoxEps = 0x1p-20f;
+inline constexpr float kBoxEps = 0x1p-16f;
 
 /// Widens a near distance towards -inf (conservative).
 inline float widen_near(float t) { return t * (t > 0.0f ? 1.0f - kBoxEps : 1.0f + kBoxEps); }

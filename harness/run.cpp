@@ -221,7 +221,7 @@ std::vector<RaySet> Runner::make_ray_sets(const Target& target) const {
   for (const RaySpec& spec : suite_.rays) {
     RaySet set;
     set.spec = &spec;
-    set.rays = spec.path.empty() ? make_rays(spec.kind, rt, spec.count, suite_.seed) : read_rays(spec.path);
+    set.rays = spec.path.empty() ? make_target_rays(target, rt, spec.kind, spec.count, suite_.seed) : read_rays(spec.path);
     sets.push_back(std::move(set));
   }
   return sets;

@@ -1,5 +1,7 @@
 #include "harness/suite.h"
 
+#include "tracer/workload.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -416,11 +418,17 @@ void validate_scenes(const Suite& suite) {
 
 void validate_rays(const Suite& suite) {
   const auto& kinds = ray_kinds();
+  // The tracer's own kinds (dof, glossy, ...) need a camera and lights: only when every scene is a scene file.
+  const bool all_scene_files = std::all_of(suite.scenes.begin(), suite.scenes.end(), [](const SceneSpec& s) {
+    return s.source == SceneSpec::Source::kScene;
+  });
   for (const auto& r : suite.rays) {
     const Where w{suite.source, r.field};
-    if (!r.kind.empty() &&
-        std::none_of(kinds.begin(), kinds.end(), [&](const RayKindInfo& k) { return k.name == r.kind; }))
-      w.at("kind").fail("unknown ray kind '" + r.kind + "'");
+    const bool mesh_kind =
+        std::any_of(kinds.begin(), kinds.end(), [&](const RayKindInfo& k) { return k.name == r.kind; });
+    if (!r.kind.empty() && !mesh_kind && !(all_scene_files && is_scene_ray_kind(r.kind)))
+      w.at("kind").fail("unknown ray kind '" + r.kind + "'" +
+                        (is_scene_ray_kind(r.kind) ? " for meshes (it needs every scene to be a scene file)" : ""));
     if (!r.path.empty() && !std::filesystem::is_regular_file(r.path))
       w.at("file").fail(r.path + ": no such file");
   }

@@ -77,7 +77,11 @@ RayTarget ray_target(const Target& target) {
 }
 
 std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count, uint64_t seed) {
-  const RayTarget rt = ray_target(target);
+  return make_target_rays(target, ray_target(target), kind, count, seed);
+}
+
+std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind, uint64_t count,
+                                  uint64_t seed) {
   if (target.scene && is_scene_ray_kind(kind)) return make_scene_rays(*target.scene, rt.trace, kind, count, seed);
   return make_rays(kind, rt, count, seed);
 }

@@ -37,6 +37,9 @@ std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const
 /// glossy, diffuse: tracer/workload.h) use its camera and lights; every other kind (and every kind for
 /// a mesh) comes from make_rays. Throws InputError for an unknown kind.
 std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count, uint64_t seed);
+/// The same with a RayTarget already made by ray_target(target) (so several ray sets share one build).
+std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind, uint64_t count,
+                                  uint64_t seed);
 
 /// What ray generation needs of the target (bounds, a closest-hit trace through a fast structure of the
 /// project, normals at hits).

@@ -124,8 +124,8 @@ TEST(SlabTest, ZeroDirectionComponentsGiveNoNaN) {
   r.org = {0.5f, 0.5f, -1};
   r.dir = {0, 0, 1};
   ASSERT_TRUE(hits_box(r, box, t0, t1));
-  EXPECT_NEAR(t0, 1.0f, 1e-5f);
-  EXPECT_NEAR(t1, 2.0f, 1e-5f);
+  EXPECT_NEAR(t0, 1.0f, 1e-4f);
+  EXPECT_NEAR(t1, 2.0f, 1e-4f);
   // Origin exactly on the x = 0 slab plane while parallel to it: 0 * inf must not poison the interval.
   r.org = {0.0f, 0.5f, -1};
   ASSERT_TRUE(hits_box(r, box, t0, t1));
@@ -133,7 +133,7 @@ TEST(SlabTest, ZeroDirectionComponentsGiveNoNaN) {
   r.org = {1.0f, 1.0f, -1};
   r.dir = {-0.0f, -0.0f, 1};
   ASSERT_TRUE(hits_box(r, box, t0, t1));
-  EXPECT_NEAR(t1, 2.0f, 1e-5f);
+  EXPECT_NEAR(t1, 2.0f, 1e-4f);
   // Parallel and outside the slab: miss, for +0 and -0.
   r.org = {1.5f, 0.5f, -1};
   r.dir = {0, 0, 1};
@@ -149,8 +149,8 @@ TEST(SlabTest, NegativeComponentsAndLimits) {
   r.org = {2, 2, 2};
   r.dir = {-1, -1, -1};
   ASSERT_TRUE(hits_box(r, box, t0, t1));
-  EXPECT_NEAR(t0, 1.0f, 1e-5f);
-  EXPECT_NEAR(t1, 2.0f, 1e-5f);
+  EXPECT_NEAR(t0, 1.0f, 1e-4f);
+  EXPECT_NEAR(t1, 2.0f, 1e-4f);
   r.tmax = 0.5f;  // ends before the box
   EXPECT_FALSE(hits_box(r, box, t0, t1));
   r.tmax = kInf;
