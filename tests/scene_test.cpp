@@ -90,7 +90,8 @@ const char* kQuad =
     "<mesh name='q'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles></mesh>\n";
 
 TEST(Scene, ParsesEverything) {
-  const Scene& s = *instanced_scene(30);
+  const auto scene = instanced_scene(30);  // keep the owner alive: a reference into a temporary dangles
+  const Scene& s = *scene;
   EXPECT_EQ(s.instances.size(), 30u);
   EXPECT_EQ(s.meshes.size(), 3u);
   EXPECT_EQ(s.meshes[2].mesh->size(), 2u);
