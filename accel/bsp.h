@@ -306,13 +306,9 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   /// Closest hit, front to back.
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    for (uint32_t i : unbounded_) prims_->template intersect<kCount>(i, ray, best, inst, c);
-    Ray r = ray;
+    intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
     auto leaf = [&](const BspNode& n) {
-      const uint32_t* ids = &ids_[n.first()];
-      r.tmax = std::min(ray.tmax, best.t);
-      for (uint32_t k = 0, e = n.second(); k < e; ++k)
-        if (prims_->template intersect<kCount>(ids[k], r, best, inst, c)) r.tmax = std::min(ray.tmax, best.t);
+      intersect_id_list<kCount>(*prims_, &ids_[n.first()], n.second(), ray, best, inst, c);
       return false;
     };
     traverse<kCount>(ray, c, leaf, [&] { return best.t; });
@@ -321,31 +317,14 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   /// Any hit.
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    for (uint32_t i : unbounded_)
-      if (prims_->template occluded<kCount>(i, ray, c)) return true;
-    auto leaf = [&](const BspNode& n) {
-      const uint32_t* ids = &ids_[n.first()];
-      for (uint32_t k = 0, e = n.second(); k < e; ++k)
-        if (prims_->template occluded<kCount>(ids[k], ray, c)) return true;
-      return false;
-    };
+    if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
+    auto leaf = [&](const BspNode& n) { return occluded_id_list<kCount>(*prims_, &ids_[n.first()], n.second(), ray, c); };
     return traverse<kCount>(ray, c, leaf, [] { return kInf; });
   }
 
  protected:
   void do_build() override {
-    std::vector<uint32_t> ids;
-    unbounded_.clear();
-    box_ = AABB{};
-    for (size_t i = 0; i < prims_->size(); ++i) {
-      const AABB b = prims_->bounds(i);
-      if (finite_box(b)) {
-        ids.push_back(uint32_t(i));
-        box_.extend(b);
-      } else {
-        unbounded_.push_back(uint32_t(i));
-      }
-    }
+    std::vector<uint32_t> ids = partition_finite(*prims_, unbounded_, box_);
     BspSettings s = s_;
     s.max_depth = max_depth_ > 0 ? max_depth_ : auto_kd_depth(ids.size());
     s.margin = ids.empty() ? 0.0f : insertion_margin(box_);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "accel/geometry.h"
+#include "accel/stats.h"
 
 #include <algorithm>
 #include <bit>
@@ -105,6 +106,49 @@ inline bool finite_box(const AABB& b) {
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a])) return false;
   return !b.empty();
+}
+
+/// Splits the primitives of `prims` into those with finite bounds (returned; their union goes into `box`)
+/// and the rest (`unbounded`: tested for every ray, so their ids and any hit are kept).
+template <class P>
+std::vector<uint32_t> partition_finite(const P& prims, std::vector<uint32_t>& unbounded, AABB& box) {
+  std::vector<uint32_t> ids;
+  unbounded.clear();
+  box = AABB{};
+  for (size_t i = 0; i < prims.size(); ++i) {
+    const AABB b = prims.bounds(i);
+    if (finite_box(b)) {
+      ids.push_back(uint32_t(i));
+      box.extend(b);
+    } else {
+      unbounded.push_back(uint32_t(i));
+    }
+  }
+  return ids;
+}
+
+/// Closest hit over a leaf's id list, on a copy of the ray whose tmax follows best.t (the kernel's t, u, v
+/// do not depend on tmax, so hits stay identical). Returns true when best changed.
+template <bool kCount, class P>
+bool intersect_id_list(const P& prims, const uint32_t* ids, uint32_t count, const Ray& ray, Hit& best,
+                       uint32_t inst, RayCounters& c) {
+  Ray r = ray;
+  r.tmax = std::min(ray.tmax, best.t);
+  bool changed = false;
+  for (uint32_t k = 0; k < count; ++k)
+    if (prims.template intersect<kCount>(ids[k], r, best, inst, c)) {
+      r.tmax = std::min(ray.tmax, best.t);
+      changed = true;
+    }
+  return changed;
+}
+
+/// True when any primitive of a leaf's id list blocks the ray.
+template <bool kCount, class P>
+bool occluded_id_list(const P& prims, const uint32_t* ids, uint32_t count, const Ray& ray, RayCounters& c) {
+  for (uint32_t k = 0; k < count; ++k)
+    if (prims.template occluded<kCount>(ids[k], ray, c)) return true;
+  return false;
 }
 
 /// Default depth limit of the k-d builders: 8 + 1.3 log2 N (Havran 2000; pbrt).

@@ -46,8 +46,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   /// Closest hit: front-to-back traversal with a stack of far children.
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    Ray r = ray;
-    for (uint32_t i : unbounded_) prims_->template intersect<kCount>(i, ray, best, inst, c);
+    intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return;
     const RayAxes axes(ray);
@@ -61,10 +60,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
         if (step(n, node, axes, t0, t1, stack, sp)) continue;
       } else {
         if constexpr (kCount) ++c.leaves;
-        r.tmax = std::min(ray.tmax, best.t);
-        const uint32_t* ids = &prims_ids_[n.first()];
-        for (uint32_t k = 0, e = n.count(); k < e; ++k)
-          if (prims_->template intersect<kCount>(ids[k], r, best, inst, c)) r.tmax = std::min(ray.tmax, best.t);
+        intersect_id_list<kCount>(*prims_, &prims_ids_[n.first()], n.count(), ray, best, inst, c);
       }
       if (!pop(stack, sp, best.t, node, t0, t1)) return;
     }
@@ -73,8 +69,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   /// Any hit: the same traversal, stopping at the first primitive that blocks the ray.
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    for (uint32_t i : unbounded_)
-      if (prims_->template occluded<kCount>(i, ray, c)) return true;
+    if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
     const RayAxes axes(ray);
@@ -88,9 +83,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
         if (step(n, node, axes, t0, t1, stack, sp)) continue;
       } else {
         if constexpr (kCount) ++c.leaves;
-        const uint32_t* ids = &prims_ids_[n.first()];
-        for (uint32_t k = 0, e = n.count(); k < e; ++k)
-          if (prims_->template occluded<kCount>(ids[k], ray, c)) return true;
+        if (occluded_id_list<kCount>(*prims_, &prims_ids_[n.first()], n.count(), ray, c)) return true;
       }
       if (!pop(stack, sp, kInf, node, t0, t1)) return false;
     }
@@ -101,18 +94,8 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
     BuildStats& st = this->stats_;
     st = BuildStats{};
     st.primitives = prims_->size();
-    std::vector<uint32_t> ids;
-    unbounded_.clear();
-    box_ = AABB{};
-    for (size_t i = 0; i < prims_->size(); ++i) {
-      const AABB b = prims_->bounds(i);
-      if (finite_box(b)) {
-        ids.push_back(uint32_t(i));
-        box_.extend(b);
-      } else {
-        unbounded_.push_back(uint32_t(i));  // NaN or infinite coordinates: tested for every ray
-      }
-    }
+    // NaN or infinite coordinates: tested for every ray.
+    std::vector<uint32_t> ids = partition_finite(*prims_, unbounded_, box_);
     KdBuffer out;
     const int depth = max_depth_ > 0 ? max_depth_ : auto_kd_depth(ids.size());
     if (!ids.empty()) {

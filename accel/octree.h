@@ -83,13 +83,9 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   /// Closest hit, children front to back.
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    for (uint32_t i : unbounded_) prims_->template intersect<kCount>(i, ray, best, inst, c);
-    Ray r = ray;
+    intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
     auto leaf = [&](const OctNode& n) {
-      const uint32_t* ids = &ids_[n.first()];
-      r.tmax = std::min(ray.tmax, best.t);
-      for (uint32_t k = 0, e = n.count(); k < e; ++k)
-        if (prims_->template intersect<kCount>(ids[k], r, best, inst, c)) r.tmax = std::min(ray.tmax, best.t);
+      intersect_id_list<kCount>(*prims_, &ids_[n.first()], n.count(), ray, best, inst, c);
       return false;
     };
     traverse<kCount>(ray, c, leaf, [&] { return best.t; });
@@ -98,31 +94,15 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   /// Any hit.
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    for (uint32_t i : unbounded_)
-      if (prims_->template occluded<kCount>(i, ray, c)) return true;
-    auto leaf = [&](const OctNode& n) {
-      const uint32_t* ids = &ids_[n.first()];
-      for (uint32_t k = 0, e = n.count(); k < e; ++k)
-        if (prims_->template occluded<kCount>(ids[k], ray, c)) return true;
-      return false;
-    };
+    if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
+    auto leaf = [&](const OctNode& n) { return occluded_id_list<kCount>(*prims_, &ids_[n.first()], n.count(), ray, c); };
     return traverse<kCount>(ray, c, leaf, [] { return kInf; });
   }
 
  protected:
   void do_build() override {
-    std::vector<uint32_t> ids;
-    unbounded_.clear();
     AABB box;
-    for (size_t i = 0; i < prims_->size(); ++i) {
-      const AABB b = prims_->bounds(i);
-      if (finite_box(b)) {
-        ids.push_back(uint32_t(i));
-        box.extend(b);
-      } else {
-        unbounded_.push_back(uint32_t(i));
-      }
-    }
+    std::vector<uint32_t> ids = partition_finite(*prims_, unbounded_, box);
     box_ = cube_around(box);
     KdLikeBuffer out;
     out.nodes.push_back(OctNode::leaf(0, 0));
