@@ -1,5 +1,6 @@
 #include "accel/bvh.h"
 
+#include "accel/bvh_build.h"
 #include "accel/registry.h"
 
 #include <tbb/blocked_range.h>
@@ -7,14 +8,13 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
-#include <numeric>
 
 namespace ab {
 
 namespace {
 
-/// Ranges at least this large compute their bounds and bins with a parallel reduction. The reductions
-/// use only min, max and integer sums, which are exact, so the result does not depend on the split.
+/// Ranges at least this large compute their bounds with a parallel reduction (min and max only: exact,
+/// so the result does not depend on the split).
 constexpr size_t kParallelReduceThreshold = 1u << 16;
 constexpr size_t kGrain = 1u << 12;
 
@@ -29,22 +29,21 @@ struct RangeBounds {
   }
 };
 
-/// A primitive as the builder moves it around: bounds, centroid and id together, so the passes over a
-/// range read contiguous memory.
+/// A primitive as the median builder moves it around: bounds, centroid and id together, so the passes
+/// over a range read contiguous memory.
 struct BuildRef {
   AABB box;
   vec3 centroid;
   uint32_t id;
 };
 
-/// The builder: recursion over ranges of the reference array `refs_`. A node for range [b, e) is
-/// written at slot p of a gapped array of 2N-1 slots; its left child is at p+1 and its right child at
-/// p + 2 (m - b), so disjoint subtrees never share slots and can be built in parallel. flatten() then
-/// compacts the slots into the final array.
-class BvhBuilder {
+// Object median: recursion over ranges of the reference array; each node is split at the median centroid
+// along the longest axis of its centroid bounds (sort-free selection with nth_element), ties broken by id
+// so the result is a function of the range alone. Large subtrees are built in parallel into BvhSlots.
+class MedianBuilder {
  public:
-  BvhBuilder(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids)
-      : method_(method), config_(config), refs_(bounds.size()), slots_(bounds.empty() ? 0 : 2 * bounds.size() - 1) {
+  MedianBuilder(const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids)
+      : config_(config), refs_(bounds.size()), slots_(bounds.size()) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, refs_.size(), kGrain), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i < r.end(); ++i) refs_[i] = {bounds[i], centroids[i], uint32_t(i)};
     });
@@ -53,51 +52,36 @@ class BvhBuilder {
   /// Builds the tree and returns the flattened result.
   BvhBuildResult run() {
     if (!refs_.empty()) build(0, 0, uint32_t(refs_.size()), 0);
-    return flatten();
+    std::vector<uint32_t> order(refs_.size());
+    for (size_t k = 0; k < refs_.size(); ++k) order[k] = refs_[k].id;
+    return flatten_bvh_slots(slots_, std::move(order));
   }
 
  private:
   void build(uint32_t p, uint32_t b, uint32_t e, int depth);
   RangeBounds range_bounds(uint32_t b, uint32_t e) const;
-  uint32_t choose_split(uint32_t b, uint32_t e, const RangeBounds& rb);
   uint32_t split_median(uint32_t b, uint32_t e, const RangeBounds& rb);
-  uint32_t split_binned(uint32_t b, uint32_t e, const RangeBounds& rb);
-  uint32_t split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb);
-  std::vector<SahBin> bin_range(uint32_t b, uint32_t e, const BinMapping& map) const;
-  uint32_t decide(uint32_t b, uint32_t e, const SahSplit& best) const;
-  BvhBuildResult flatten() const;
 
-  BvhMethod method_;
-  BvhConfig config_;
+  const BvhConfig& config_;
   std::vector<BuildRef> refs_;
-  std::vector<BvhNode> slots_;
+  BvhSlots slots_;
 };
 
-void BvhBuilder::build(uint32_t p, uint32_t b, uint32_t e, int depth) {
+void MedianBuilder::build(uint32_t p, uint32_t b, uint32_t e, int depth) {
   const RangeBounds rb = range_bounds(b, e);
-  BvhNode& node = slots_[p];
-  for (int a = 0; a < 3; ++a) {
-    node.lo[a] = rb.bounds.lo[a];
-    node.hi[a] = rb.bounds.hi[a];
-  }
-  const uint32_t m = (depth >= config_.max_depth || e - b == 1) ? b : choose_split(b, e, rb);
-  if (m == b) {  // leaf
-    node.offset = b;
-    node.count = e - b;
-    return;
-  }
-  const uint32_t left = p + 1, right = p + 2 * (m - b);
-  node.offset = right;
-  node.count = 0;
+  slots_.set_box(p, rb.bounds);
+  const uint32_t m = depth >= config_.max_depth ? b : split_median(b, e, rb);
+  if (m == b) return slots_.set_leaf(p, b, e);
+  const uint32_t right = slots_.set_interior(p, b, m);
   if (e - b >= config_.parallel_threshold) {
-    tbb::parallel_invoke([&] { build(left, b, m, depth + 1); }, [&] { build(right, m, e, depth + 1); });
+    tbb::parallel_invoke([&] { build(p + 1, b, m, depth + 1); }, [&] { build(right, m, e, depth + 1); });
   } else {
-    build(left, b, m, depth + 1);
+    build(p + 1, b, m, depth + 1);
     build(right, m, e, depth + 1);
   }
 }
 
-RangeBounds BvhBuilder::range_bounds(uint32_t b, uint32_t e) const {
+RangeBounds MedianBuilder::range_bounds(uint32_t b, uint32_t e) const {
   auto body = [&](const tbb::blocked_range<uint32_t>& r, RangeBounds acc) {
     for (uint32_t k = r.begin(); k < r.end(); ++k) {
       acc.bounds.extend(refs_[k].box);
@@ -114,21 +98,7 @@ RangeBounds BvhBuilder::range_bounds(uint32_t b, uint32_t e) const {
 }
 
 /// Returns the split index m in (b, e), or b for a leaf.
-uint32_t BvhBuilder::choose_split(uint32_t b, uint32_t e, const RangeBounds& rb) {
-  switch (method_) {
-    case BvhMethod::kMedian:
-      return split_median(b, e, rb);
-    case BvhMethod::kBinnedSah:
-      return split_binned(b, e, rb);
-    case BvhMethod::kSweepSah:
-      return split_sweep(b, e, rb);
-  }
-  return b;
-}
-
-// Object median: sort-free selection (nth_element) of the centroid median along the longest axis of
-// the centroid bounds; ties broken by id so the result is a function of the range alone.
-uint32_t BvhBuilder::split_median(uint32_t b, uint32_t e, const RangeBounds& rb) {
+uint32_t MedianBuilder::split_median(uint32_t b, uint32_t e, const RangeBounds& rb) {
   const uint32_t n = e - b;
   if (n <= uint32_t(config_.max_leaf_size)) return b;
   const int axis = rb.centroids.longest_axis();
@@ -141,110 +111,29 @@ uint32_t BvhBuilder::split_median(uint32_t b, uint32_t e, const RangeBounds& rb)
   return m;
 }
 
-/// Leaf or split given the best SAH split: a leaf when the SAH says splitting does not pay and the node
-/// is small enough; a forced split in the middle when no valid split exists but the node is too big.
-uint32_t BvhBuilder::decide(uint32_t b, uint32_t e, const SahSplit& best) const {
-  const uint32_t n = e - b;
-  const bool small = n <= uint32_t(config_.max_leaf_size);
-  if (best.axis < 0) return small ? b : b + n / 2;
-  if (small && best.cost >= config_.costs.leaf(n)) return b;
-  return e;  // "split as found"
-}
-
-std::vector<SahBin> BvhBuilder::bin_range(uint32_t b, uint32_t e, const BinMapping& map) const {
-  const size_t nb = size_t(map.bins);
-  auto body = [&](const tbb::blocked_range<uint32_t>& r, std::vector<SahBin> acc) {
-    if (acc.empty()) acc.resize(3 * nb);
-    for (uint32_t k = r.begin(); k < r.end(); ++k) {
-      const BuildRef& ref = refs_[k];
-      for (int a = 0; a < 3; ++a) acc[a * nb + map.bin(a, ref.centroid[a])].add(ref.box);
-    }
-    return acc;
-  };
-  if (e - b < kParallelReduceThreshold) return body({b, e}, std::vector<SahBin>(3 * nb));
-  return tbb::parallel_reduce(tbb::blocked_range<uint32_t>(b, e, kGrain), std::vector<SahBin>(3 * nb), body,
-                              [](std::vector<SahBin> x, const std::vector<SahBin>& y) {
-                                for (size_t i = 0; i < x.size(); ++i) x[i].merge(y[i]);
-                                return x;
-                              });
-}
-
-// Binned SAH (Wald 2007): centroids are projected into equal-width bins on each axis, the bins are
-// swept to evaluate every bin boundary, and the range is partitioned at the cheapest one.
-uint32_t BvhBuilder::split_binned(uint32_t b, uint32_t e, const RangeBounds& rb) {
-  // Small nodes use as many bins as primitives (more could not separate them any better on average, and
-  // evaluating unused boundaries dominates the cost near the leaves).
-  const BinMapping map(rb.centroids, std::min(config_.bins, std::max(4, int(e - b))));
-  const std::vector<SahBin> bins = bin_range(b, e, map);
-  SahSplit best;
-  const float area = rb.bounds.area();
-  for (int a = 0; a < 3; ++a)
-    if (map.scale[a] > 0.0f) best_bin_split(&bins[a * size_t(map.bins)], map.bins, a, area, config_.costs, best);
-  const uint32_t d = decide(b, e, best);
-  if (d != e) return d;
-  const auto mid = std::partition(refs_.begin() + b, refs_.begin() + e, [&](const BuildRef& ref) {
-    return map.bin(best.axis, ref.centroid[best.axis]) < best.position;
-  });
-  return uint32_t(mid - refs_.begin());
-}
-
-// Full sweep SAH (MacDonald and Booth 1990, as the reference in Wald 2007): on each axis the centroids
-// are sorted and every split between consecutive primitives is evaluated with exact child bounds.
-uint32_t BvhBuilder::split_sweep(uint32_t b, uint32_t e, const RangeBounds& rb) {
-  const uint32_t n = e - b;
-  std::vector<uint32_t> sorted(n), best_sorted;  // positions in refs_
-  std::iota(sorted.begin(), sorted.end(), b);
-  std::vector<float> right_area(n);
-  SahSplit best;
-  const float area = rb.bounds.area();
-  for (int a = 0; a < 3; ++a) {
-    if (!(rb.centroids.extent()[a] > 0.0f)) continue;  // all centroids on one plane: no split on this axis
-    std::sort(sorted.begin(), sorted.end(), [&](uint32_t x, uint32_t y) {
-      const float cx = refs_[x].centroid[a], cy = refs_[y].centroid[a];
-      return cx != cy ? cx < cy : refs_[x].id < refs_[y].id;
-    });
-    AABB acc;
-    for (uint32_t i = n - 1; i > 0; --i) {
-      acc.extend(refs_[sorted[i]].box);
-      right_area[i] = acc.area();
-    }
-    acc = AABB{};
-    const float before = best.cost;
-    for (uint32_t i = 1; i < n; ++i) {
-      acc.extend(refs_[sorted[i - 1]].box);
-      const float c = config_.costs.split(area, acc.area(), i, right_area[i], n - i);
-      if (c < best.cost) best = {a, int(i), c};
-    }
-    if (best.cost < before) best_sorted = sorted;
-  }
-  const uint32_t d = decide(b, e, best);
-  if (d != e) return d;
-  std::vector<BuildRef> permuted(n);
-  for (uint32_t i = 0; i < n; ++i) permuted[i] = refs_[best_sorted[i]];
-  std::copy(permuted.begin(), permuted.end(), refs_.begin() + b);
-  return b + uint32_t(best.position);
-}
+}  // namespace
 
 /// Compacts the gapped slots into the final array: root at 0, padding at 1, then sibling pairs allocated
 /// in depth-first order (a node's children pair is allocated when the node is reached), and gathers the
 /// statistics.
-BvhBuildResult BvhBuilder::flatten() const {
+BvhBuildResult flatten_bvh_slots(const BvhSlots& slots, std::vector<uint32_t> order) {
   BvhBuildResult out;
-  out.order.resize(refs_.size());
-  for (size_t k = 0; k < refs_.size(); ++k) out.order[k] = refs_[k].id;
-  out.stats.primitives = refs_.size();
-  if (slots_.empty()) return out;
+  out.stats.primitives = order.size();
+  out.order = std::move(order);
+  if (slots.slots.empty()) return out;
   struct Item {
     uint32_t slot, index, depth;
   };
+  const std::vector<BvhNode>& in = slots.slots;
+  out.nodes.reserve(in.size() + 1);
   out.nodes.resize(2);
   out.nodes[1] = BvhNode{{kInf, kInf, kInf}, 0, {-kInf, -kInf, -kInf}, 1};  // padding, never visited
   std::vector<Item> stack{{0, 0, 0}};
-  SahCostAccumulator sah(slots_[0].box().area());
+  SahCostAccumulator sah(in[0].box().area());
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
-    BvhNode node = slots_[it.slot];
+    BvhNode node = in[it.slot];
     if (node.is_leaf()) {
       out.stats.add_leaf(node.count, it.depth);
       sah.add_leaf(node.box().area(), node.count);
@@ -263,11 +152,17 @@ BvhBuildResult BvhBuilder::flatten() const {
   return out;
 }
 
-}  // namespace
-
 BvhBuildResult build_bvh(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds,
                          std::span<const vec3> centroids) {
-  return BvhBuilder(method, config, bounds, centroids).run();
+  switch (method) {
+    case BvhMethod::kBinnedSah:
+      return build_bvh_binned(config, bounds);
+    case BvhMethod::kSweepSah:
+      return build_bvh_sweep(config, bounds, centroids);
+    case BvhMethod::kMedian:
+      break;
+  }
+  return MedianBuilder(config, bounds, centroids).run();
 }
 
 const char* bvh_method_name(BvhMethod method) {

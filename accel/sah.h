@@ -15,14 +15,17 @@ namespace ab {
 /// Traversal and intersection costs of the SAH. The normalized cost reported in BuildStats uses 1 and 1.
 struct SahCosts {
   float traversal = 1.0f;     ///< cost of visiting an interior node
-  float intersection = 1.0f;  ///< cost of one primitive test
+  float intersection = 1.0f;  ///< cost of one primitive test (of one block, when block > 1)
+  uint32_t block = 1;         ///< primitives tested at once (4 for SIMD triangle blocks, as in Embree)
 
+  /// Tests needed for n primitives: ceil(n / block).
+  float tests(size_t n) const { return float((n + block - 1) / block); }
   /// Cost of a leaf of n primitives (relative to its parent's area ratio, i.e. per unit probability).
-  float leaf(size_t n) const { return intersection * float(n); }
+  float leaf(size_t n) const { return intersection * tests(n); }
   /// Cost of splitting a node of area `parent_area` into children (area, count) pairs.
   float split(float parent_area, float left_area, size_t left_n, float right_area, size_t right_n) const {
-    if (!(parent_area > 0.0f)) return traversal + intersection * float(left_n + right_n);
-    return traversal + intersection * (left_area * float(left_n) + right_area * float(right_n)) / parent_area;
+    if (!(parent_area > 0.0f)) return traversal + intersection * (tests(left_n) + tests(right_n));
+    return traversal + intersection * (left_area * tests(left_n) + right_area * tests(right_n)) / parent_area;
   }
 };
 
@@ -71,29 +74,51 @@ struct SahSplit {
   float cost = kInf;   ///< SAH cost of the split (with the costs used)
 };
 
-/// Best split among the bin boundaries of one axis: sweeps right to left to get suffix areas, then
-/// left to right evaluating every boundary (Wald 2007). Updates best when a cheaper split is found.
-inline void best_bin_split(const SahBin* bins, int n, int axis, float parent_area, const SahCosts& costs,
-                           SahSplit& best) {
+/// Best split among the n bin boundaries of one axis, for any bin representation: box_of(k) and count_of(k)
+/// give bin k, Box (starting from `empty`) has extend(box) and area(). Sweeps right to left to get suffix
+/// areas, then left to right evaluating every boundary (Wald 2007). Updates best when a cheaper split is found.
+template <class Box, class BoxOf, class CountOf>
+inline void best_bin_split_of(int n, int axis, float parent_area, const SahCosts& costs, SahSplit& best,
+                              const Box& empty, BoxOf box_of, CountOf count_of) {
   std::array<float, 256> right_area;     // only [1, n) is written and read: no zeroing (this runs per node)
   std::array<uint32_t, 256> right_count;
-  AABB acc;
+  Box acc = empty;
   uint32_t cnt = 0;
   for (int i = n - 1; i > 0; --i) {
-    acc.extend(bins[i].bounds);
-    cnt += bins[i].count;
+    acc.extend(box_of(i));
+    cnt += count_of(i);
     right_area[i] = acc.area();
     right_count[i] = cnt;
   }
-  acc = AABB{};
+  // The cheapest boundary minimizes left_area * left_count + right_area * right_count (the cost without
+  // its constant terms, so no division per boundary); its full cost is computed once.
+  acc = empty;
   cnt = 0;
+  float best_weighted = kInf, best_left_area = 0.0f, best_right_area = 0.0f;
+  int best_i = 0;
+  uint32_t best_left = 0;
   for (int i = 1; i < n; ++i) {
-    acc.extend(bins[i - 1].bounds);
-    cnt += bins[i - 1].count;
+    acc.extend(box_of(i - 1));
+    cnt += count_of(i - 1);
     if (cnt == 0 || right_count[i] == 0) continue;
-    const float c = costs.split(parent_area, acc.area(), cnt, right_area[i], right_count[i]);
-    if (c < best.cost) best = {axis, i, c};
+    const float left_area = acc.area();
+    const float weighted = left_area * float(cnt) + right_area[i] * float(right_count[i]);
+    if (weighted < best_weighted) {
+      best_weighted = weighted, best_i = i, best_left = cnt;
+      best_left_area = left_area, best_right_area = right_area[i];
+    }
   }
+  if (best_i == 0) return;
+  const float c = costs.split(parent_area, best_left_area, best_left, best_right_area, right_count[best_i]);
+  if (c < best.cost) best = {axis, best_i, c};
+}
+
+/// best_bin_split_of over an array of SahBin.
+inline void best_bin_split(const SahBin* bins, int n, int axis, float parent_area, const SahCosts& costs,
+                           SahSplit& best) {
+  best_bin_split_of(
+      n, axis, parent_area, costs, best, AABB{}, [&](int k) -> const AABB& { return bins[k].bounds; },
+      [&](int k) { return bins[k].count; });
 }
 
 /// Normalized SAH cost of a finished tree given per-node areas: sum over interior nodes of

@@ -1,0 +1,298 @@
+#include "accel/bvh_build.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+
+namespace ab {
+
+namespace {
+
+/// Nodes at least this large bin and bound their primitives with a parallel reduction. The reductions use
+/// only min, max and integer sums, which are exact, so the result does not depend on how TBB splits.
+constexpr size_t kParallelReduceThreshold = 1u << 15;
+constexpr size_t kGrain = 1u << 12;
+constexpr int kMaxBins = 256;
+
+/// A primitive as the binned builder moves it: its box as two 16-byte vectors, the id in the lo vector's
+/// fourth lane (never used in arithmetic: it is blended out first) and zero in the hi vector's.
+struct alignas(32) BinRef {
+  float lo[3];
+  uint32_t id;
+  float hi[3];
+  float zero;
+
+  __m128 lo4() const { return _mm_load_ps(lo); }
+  __m128 hi4() const { return _mm_load_ps(hi); }
+  /// The centre of the box, 0.5 * (lo + hi), bit for bit what AABB::center() and the primitive sets'
+  /// centroid() give (fourth lane 0).
+  __m128 center() const { return _mm_mul_ps(_mm_add_ps(_mm_blend_ps(lo4(), _mm_setzero_ps(), 8), hi4()), _mm_set1_ps(0.5f)); }
+};
+static_assert(sizeof(BinRef) == 32);
+
+/// A box as two vectors. Not initialized by default (bins are reset explicitly, only as many as used).
+struct alignas(16) Box4 {
+  __m128 lo;
+  __m128 hi;
+
+  /// The empty box (lo = +inf, hi = -inf).
+  static Box4 empty() { return {_mm_set1_ps(kInf), _mm_set1_ps(-kInf)}; }
+  void extend(__m128 l, __m128 h) {
+    lo = _mm_min_ps(lo, l);
+    hi = _mm_max_ps(hi, h);
+  }
+  void extend(const Box4& b) { extend(b.lo, b.hi); }
+  /// The same value as AABB::area() of the same box (0 when empty).
+  float area() const {
+    alignas(16) float d[4];
+    _mm_store_ps(d, _mm_sub_ps(hi, lo));
+    if (d[0] < 0.0f || d[1] < 0.0f || d[2] < 0.0f) return 0.0f;
+    return 2.0f * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+  }
+  AABB aabb() const {
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+  }
+};
+
+/// The node's box and the box of its primitives' centroids, passed from a parent to its children.
+struct NodeBounds {
+  Box4 box = Box4::empty();
+  Box4 centroids = Box4::empty();
+};
+
+/// The bin of a centre on all three axes at once: int((c - lo) * scale) clamped to [0, bins - 1], the
+/// arithmetic of BinMapping::bin (sah.h) in one vector.
+struct BinIndexer {
+  __m128 lo, scale;
+  __m128i last;
+
+  explicit BinIndexer(const BinMapping& m)
+      : lo(_mm_setr_ps(m.lo[0], m.lo[1], m.lo[2], 0.0f)), scale(_mm_setr_ps(m.scale[0], m.scale[1], m.scale[2], 0.0f)),
+        last(_mm_set1_epi32(m.bins - 1)) {}
+  __m128i bins(__m128 c) const {
+    const __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
+    return _mm_min_epi32(_mm_max_epi32(k, _mm_setzero_si128()), last);
+  }
+};
+
+/// The bins of one node on the three axes (axis a, bin k at a * nb + k), reducible in parallel.
+struct BinSet {
+  int nb;
+  std::array<Box4, 3 * kMaxBins> box;
+  std::array<uint32_t, 3 * kMaxBins> count;
+
+  explicit BinSet(int bins) : nb(bins) {
+    for (int k = 0; k < 3 * nb; ++k) box[k] = Box4::empty(), count[k] = 0;
+  }
+  void add(const BinRef* refs, uint32_t b, uint32_t e, const BinIndexer& ix) {
+    for (uint32_t k = b; k < e; ++k) {
+      const __m128 lo = refs[k].lo4(), hi = refs[k].hi4();
+      alignas(16) int32_t bin[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(refs[k].center()));
+      for (int a = 0; a < 3; ++a) {
+        const int j = a * nb + bin[a];
+        box[j].extend(lo, hi);
+        ++count[j];
+      }
+    }
+  }
+  void merge(const BinSet& o) {
+    for (int k = 0; k < 3 * nb; ++k) box[k].extend(o.box[k]), count[k] += o.count[k];
+  }
+};
+
+/// TBB body binning a large range in parallel (the imperative form: a BinSet is copied only when a
+/// subrange is stolen).
+struct ParallelBinning {
+  const BinRef* refs;
+  const BinIndexer& ix;
+  BinSet bins;
+
+  ParallelBinning(const BinRef* r, const BinIndexer& i, int nb) : refs(r), ix(i), bins(nb) {}
+  ParallelBinning(ParallelBinning& o, tbb::split) : refs(o.refs), ix(o.ix), bins(o.bins.nb) {}
+  void operator()(const tbb::blocked_range<uint32_t>& r) { bins.add(refs, r.begin(), r.end(), ix); }
+  void join(const ParallelBinning& o) { bins.merge(o.bins); }
+};
+
+/// The chosen split of a node: SahSplit plus the children's boxes (unions of bins).
+struct BinnedSplit {
+  SahSplit sah;
+  Box4 left = Box4::empty(), right = Box4::empty();
+  uint32_t left_count = 0;
+};
+
+// Binned SAH (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies"): at each node the
+// centroids are projected into equal-width bins on all three axes in one pass (SSE: one vector of bin
+// indices and one box update per axis), every bin boundary is evaluated by a sweep over the bins, and the
+// range is partitioned at the cheapest one. The partition pass also computes the children's
+// centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. Nodes
+// above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
+// parallel; the tree is the same for any number of threads.
+class BinnedBuilder {
+ public:
+  BinnedBuilder(const BvhConfig& config, std::span<const AABB> bounds);
+
+  /// Builds the tree and returns the flattened result.
+  BvhBuildResult run();
+
+ private:
+  void build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth);
+  BinnedSplit find_split(uint32_t b, uint32_t e, const NodeBounds& nb, const BinMapping& map) const;
+  void partition(uint32_t b, uint32_t m, uint32_t e, int axis, int position, const BinMapping& map, Box4& left_c,
+                 Box4& right_c);
+  NodeBounds root_bounds() const;
+
+  const BvhConfig& config_;
+  std::vector<BinRef> refs_;
+  std::vector<BinRef> scratch_;  ///< partition buffer (ranges of parallel nodes are disjoint)
+  BvhSlots slots_;
+};
+
+BinnedBuilder::BinnedBuilder(const BvhConfig& config, std::span<const AABB> bounds)
+    : config_(config), refs_(bounds.size()), scratch_(bounds.size()), slots_(bounds.size()) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, refs_.size(), kGrain), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const AABB& b = bounds[i];
+      refs_[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+    }
+  });
+}
+
+BvhBuildResult BinnedBuilder::run() {
+  const size_t n = refs_.size();
+  if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0);
+  std::vector<uint32_t> order(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs_[k].id;
+  });
+  return flatten_bvh_slots(slots_, std::move(order));
+}
+
+NodeBounds BinnedBuilder::root_bounds() const {
+  auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      acc.box.extend(refs_[k].lo4(), refs_[k].hi4());
+      const __m128 c = refs_[k].center();
+      acc.centroids.extend(c, c);
+    }
+    return acc;
+  };
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, refs_.size(), kGrain), NodeBounds{}, body,
+                              [](NodeBounds x, const NodeBounds& y) {
+                                x.box.extend(y.box);
+                                x.centroids.extend(y.centroids);
+                                return x;
+                              });
+}
+
+void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth) {
+  const AABB box = nb.box.aabb();
+  slots_.set_box(p, box);
+  const uint32_t n = e - b;
+  if (depth >= config_.max_depth || n == 1) return slots_.set_leaf(p, b, e);
+  // Small nodes use as many bins as primitives (at least 4): more could not separate them better on
+  // average, and evaluating unused boundaries would dominate the cost near the leaves.
+  const BinMapping map(nb.centroids.aabb(), std::min(config_.bins, std::max(4, int(n))));
+  const BinnedSplit split = find_split(b, e, nb, map);
+  const uint32_t decision = sah_decision(n, split.sah, config_);
+  if (decision == 0) return slots_.set_leaf(p, b, e);
+  NodeBounds left, right;
+  uint32_t m;
+  if (decision == n) {
+    left.box = split.left;
+    right.box = split.right;
+    m = b + split.left_count;
+    partition(b, m, e, split.sah.axis, split.sah.position, map, left.centroids, right.centroids);
+  } else {  // forced split in the middle of the current order
+    m = b + decision;
+    for (uint32_t k = b; k < e; ++k) {
+      NodeBounds& side = k < m ? left : right;
+      side.box.extend(refs_[k].lo4(), refs_[k].hi4());
+      side.centroids.extend(refs_[k].center(), refs_[k].center());
+    }
+  }
+  const uint32_t right_slot = slots_.set_interior(p, b, m);
+  auto build_left = [&] { build(p + 1, b, m, left, depth + 1); };
+  auto build_right = [&] { build(right_slot, m, e, right, depth + 1); };
+  if (n >= config_.parallel_threshold) {
+    tbb::parallel_invoke(build_left, build_right);
+  } else {
+    build_left();
+    build_right();
+  }
+}
+
+/// Bins the node with `map` and finds the cheapest bin boundary over the three axes.
+BinnedSplit BinnedBuilder::find_split(uint32_t b, uint32_t e, const NodeBounds& nb, const BinMapping& map) const {
+  const BinIndexer ix(map);
+  BinnedSplit out;
+  auto evaluate = [&](const BinSet& bins) {
+    const float area = nb.box.area();
+    for (int a = 0; a < 3; ++a)
+      if (map.scale[a] > 0.0f) {
+        const Box4* box = &bins.box[a * bins.nb];
+        const uint32_t* count = &bins.count[a * bins.nb];
+        best_bin_split_of(
+            bins.nb, a, area, config_.costs, out.sah, Box4::empty(), [&](int k) -> const Box4& { return box[k]; },
+            [&](int k) { return count[k]; });
+      }
+    if (out.sah.axis < 0) return;
+    const int base = out.sah.axis * bins.nb;
+    for (int k = 0; k < bins.nb; ++k) {
+      (k < out.sah.position ? out.left : out.right).extend(bins.box[base + k]);
+      if (k < out.sah.position) out.left_count += bins.count[base + k];
+    }
+  };
+  if (e - b < kParallelReduceThreshold) {
+    BinSet bins(map.bins);
+    bins.add(refs_.data(), b, e, ix);
+    evaluate(bins);
+  } else {
+    ParallelBinning body(refs_.data(), ix, map.bins);
+    tbb::parallel_reduce(tbb::blocked_range<uint32_t>(b, e, kGrain), body);
+    evaluate(body.bins);
+  }
+  return out;
+}
+
+/// Partitions [b, e) stably into [b, m), the primitives whose bin on `axis` lies below `position` (m - b
+/// of them, known from the bins), and [m, e), gathering each side's centroid bounds. Branch-free: each
+/// reference is written to the scratch buffer at the cursor of its side (a conditional move, not a
+/// mispredicted branch), then the range is copied back.
+void BinnedBuilder::partition(uint32_t b, uint32_t m, uint32_t e, int axis, int position, const BinMapping& map,
+                              Box4& left_c, Box4& right_c) {
+  const BinRef* refs = refs_.data();
+  BinRef* out = scratch_.data();
+  const float lo = map.lo[axis], scale = map.scale[axis];
+  const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
+  uint32_t l = b, r = m;
+  for (uint32_t k = b; k < e; ++k) {
+    const BinRef& ref = refs[k];
+    const float c_axis = (ref.lo[axis] + ref.hi[axis]) * 0.5f;  // lane `axis` of center(), bit for bit
+    const bool left = std::clamp(int((c_axis - lo) * scale), 0, map.bins - 1) < position;
+    out[left ? l : r] = ref;
+    l += left;
+    r += !left;
+    const __m128 c = ref.center(), mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
+    left_c.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
+    right_c.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
+  }
+  std::copy(out + b, out + e, refs_.data() + b);
+}
+
+}  // namespace
+
+BvhBuildResult build_bvh_binned(const BvhConfig& config, std::span<const AABB> bounds) {
+  return BinnedBuilder(config, bounds).run();
+}
+
+}  // namespace ab

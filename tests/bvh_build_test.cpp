@@ -1,0 +1,172 @@
+// Tests of the BVH builders themselves (build_bvh): the presorted full sweep against a naive sweep that
+// re-sorts at every node, thread independence with the parallel paths forced on, forced splits.
+#include "accel/bvh_build.h"
+#include "tests/structure_test_helpers.h"
+
+#include <tbb/task_arena.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+
+namespace ab {
+namespace {
+
+using testing::random_soup;
+
+struct Inputs {
+  std::vector<AABB> bounds;
+  std::vector<vec3> centroids;
+};
+
+Inputs inputs_of(const Mesh& mesh) {
+  Inputs in;
+  for (size_t i = 0; i < mesh.size(); ++i) {
+    in.bounds.push_back(mesh.triangle(i).bounds());
+    in.centroids.push_back(in.bounds.back().center());
+  }
+  return in;
+}
+
+/// The textbook full sweep: sort the node's primitives on each axis (centroid, then id), evaluate every
+/// split, recurse. Checks the built tree node by node: the same box, the same leaves with the same ids.
+class NaiveSweepCheck {
+ public:
+  NaiveSweepCheck(const Inputs& in, const BvhConfig& config, const BvhBuildResult& built)
+      : in_(in), config_(config), built_(built) {}
+
+  void check(std::vector<uint32_t> ids, uint32_t node, int depth) {
+    AABB box;
+    for (uint32_t id : ids) box.extend(in_.bounds[id]);
+    const BvhNode& n = built_.nodes[node];
+    const AABB built_box = n.box();
+    ASSERT_EQ(std::memcmp(&built_box, &box, sizeof(AABB)), 0) << "node " << node;
+    const uint32_t count = uint32_t(ids.size());
+    SahSplit best;
+    std::vector<uint32_t> best_order;
+    uint32_t decision = 0;
+    if (depth < config_.max_depth && count > 1) {
+      for (int a = 0; a < 3; ++a) sweep_axis(ids, a, box.area(), best, best_order);
+      decision = sah_decision(count, best, config_);
+    }
+    if (decision == 0) {
+      ASSERT_TRUE(n.is_leaf()) << "node " << node;
+      std::vector<uint32_t> leaf(built_.order.begin() + n.offset, built_.order.begin() + n.offset + n.count);
+      std::sort(leaf.begin(), leaf.end());
+      std::sort(ids.begin(), ids.end());
+      EXPECT_EQ(leaf, ids);
+      return;
+    }
+    ASSERT_FALSE(n.is_leaf()) << "node " << node;
+    if (decision != count) {  // forced split: halves in x order
+      best_order = sorted(ids, 0);
+      best.position = int(decision);
+    }
+    const auto mid = best_order.begin() + best.position;
+    check(std::vector<uint32_t>(best_order.begin(), mid), n.offset, depth + 1);
+    check(std::vector<uint32_t>(mid, best_order.end()), n.offset + 1, depth + 1);
+  }
+
+ private:
+  std::vector<uint32_t> sorted(std::vector<uint32_t> ids, int a) const {
+    std::sort(ids.begin(), ids.end(), [&](uint32_t x, uint32_t y) {
+      const float cx = in_.centroids[x][a], cy = in_.centroids[y][a];
+      return cx != cy ? cx < cy : x < y;
+    });
+    return ids;
+  }
+  void sweep_axis(const std::vector<uint32_t>& ids, int a, float area, SahSplit& best, std::vector<uint32_t>& order) {
+    const std::vector<uint32_t> s = sorted(ids, a);
+    if (!(in_.centroids[s.back()][a] > in_.centroids[s.front()][a])) return;
+    const size_t n = s.size();
+    for (size_t i = 1; i < n; ++i) {
+      AABB left, right;
+      for (size_t k = 0; k < i; ++k) left.extend(in_.bounds[s[k]]);
+      for (size_t k = i; k < n; ++k) right.extend(in_.bounds[s[k]]);
+      const float c = config_.costs.split(area, left.area(), i, right.area(), n - i);
+      if (c < best.cost) best = {a, int(i), c}, order = s;
+    }
+  }
+
+  const Inputs& in_;
+  const BvhConfig& config_;
+  const BvhBuildResult& built_;
+};
+
+TEST(BvhBuild, PresortedSweepEqualsResortingAtEveryNode) {
+  Mesh mesh = random_soup(600, 3, 0.2f);
+  // Equal centroids on some axes (ties resolved by id) and a cluster of duplicates (forced splits).
+  for (size_t i = 0; i < 40; ++i) mesh.triangles.push_back(mesh.triangles[i % 4]);
+  const Inputs in = inputs_of(mesh);
+  BvhConfig config;
+  config.max_leaf_size = 4;
+  config.parallel_threshold = 64;
+  const BvhBuildResult built = build_bvh(BvhMethod::kSweepSah, config, in.bounds, in.centroids);
+  std::vector<uint32_t> all(mesh.size());
+  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  NaiveSweepCheck(in, config, built).check(all, 0, 0);
+}
+
+/// Builds with `threads` threads and the parallel paths forced on for small subtrees.
+BvhBuildResult build_with(BvhMethod method, const Inputs& in, int threads) {
+  BvhConfig config;
+  config.parallel_threshold = 32;
+  tbb::task_arena arena(threads);
+  BvhBuildResult r;
+  arena.execute([&] { r = build_bvh(method, config, in.bounds, in.centroids); });
+  return r;
+}
+
+TEST(BvhBuild, SameTreeForAnyThreadCountWithParallelPathsForced) {
+  const Inputs in = inputs_of(random_soup(70000, 21, 0.01f));  // above the parallel binning threshold
+  for (BvhMethod method : {BvhMethod::kBinnedSah, BvhMethod::kSweepSah, BvhMethod::kMedian}) {
+    const BvhBuildResult one = build_with(method, in, 1), two = build_with(method, in, 2);
+    ASSERT_EQ(one.nodes.size(), two.nodes.size()) << bvh_method_name(method);
+    EXPECT_EQ(std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(BvhNode)), 0)
+        << bvh_method_name(method);
+    EXPECT_EQ(one.order, two.order) << bvh_method_name(method);
+    EXPECT_EQ(one.stats.sah_cost, two.stats.sah_cost);
+  }
+}
+
+TEST(BvhBuild, BinnedChildBoxesAreTightAndLeavesAPermutation) {
+  const Mesh mesh = random_soup(5000, 8, 0.05f);
+  const Inputs in = inputs_of(mesh);
+  BvhConfig config;
+  const BvhBuildResult r = build_bvh(BvhMethod::kBinnedSah, config, in.bounds, in.centroids);
+  std::vector<int> seen(mesh.size(), 0);
+  // Each node's box is exactly the union of its children's (or its primitives') boxes.
+  for (size_t i = 0; i < r.nodes.size(); ++i) {
+    if (i == 1) continue;
+    const BvhNode& n = r.nodes[i];
+    AABB u;
+    if (n.is_leaf()) {
+      EXPECT_LE(n.count, uint32_t(config.max_leaf_size));
+      for (uint32_t k = n.offset; k < n.offset + n.count; ++k) u.extend(in.bounds[r.order[k]]), ++seen[r.order[k]];
+    } else {
+      u.extend(r.nodes[n.offset].box());
+      u.extend(r.nodes[n.offset + 1].box());
+    }
+    const AABB box = n.box();
+    EXPECT_EQ(std::memcmp(&u, &box, sizeof(AABB)), 0) << i;
+  }
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+}
+
+TEST(BvhBuild, CoincidentCentroidsAreSplitByForce) {
+  Mesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+  for (int i = 0; i < 50; ++i) mesh.triangles.push_back(i % 2 ? glm::uvec3{0, 1, 2} : glm::uvec3{0, 3, 4});
+  const Inputs in = inputs_of(mesh);  // two centroids, 25 primitives on each
+  for (BvhMethod method : {BvhMethod::kBinnedSah, BvhMethod::kSweepSah}) {
+    BvhConfig config;
+    config.max_leaf_size = 4;
+    const BvhBuildResult r = build_bvh(method, config, in.bounds, in.centroids);
+    EXPECT_LE(r.stats.leaf_size_histogram.rbegin()->first, 4u) << bvh_method_name(method);
+    EXPECT_EQ(r.stats.references, mesh.size());
+  }
+}
+
+}  // namespace
+}  // namespace ab
