@@ -1,12 +1,17 @@
-// Binary bounding volume hierarchies over any primitive set: object median (bvh-median), binned SAH
-// (bvh-sah, Wald 2007) and full-sweep SAH (bvh-sweep, MacDonald and Booth 1990). All three flatten into
-// one depth-first array of 32-byte nodes traversed with an explicit stack, nearer child first.
+// Bounding volume hierarchies over any primitive set: object median (bvh-median), binned SAH (bvh-sah,
+// Wald 2007) and full-sweep SAH (bvh-sweep, MacDonald and Booth 1990). All three build one depth-first
+// array of 32-byte binary nodes traversed with an explicit stack, nearer child first (`width=2`, the default
+// of bvh-median and bvh-sweep); with `width=8` (bvh-sah's default) that tree is collapsed into an 8-wide
+// BVH whose child boxes are tested at once with AVX2 (bvh_wide.h).
 #pragma once
 
 #include "accel/accelerator.h"
+#include "accel/bvh_node.h"
+#include "accel/bvh_wide.h"
 #include "accel/params.h"
 #include "accel/primitives.h"
 #include "accel/sah.h"
+#include "accel/triangle4.h"
 
 #include <tbb/parallel_for.h>
 
@@ -20,38 +25,6 @@
 #include <vector>
 
 namespace ab {
-
-/// One flattened BVH node. Interior (count == 0): the children are the sibling pair `offset`, `offset + 1`
-/// (one 64-byte line, so one fetch gives both boxes for the two-box test). Leaf (count > 0): primitives
-/// [offset, offset + count) of the leaf-ordered reference array. The layout (lo, offset, hi, count) lets
-/// a node load as one 32-byte vector. Node 0 is the root, node 1 is padding, pairs start at 2.
-struct alignas(32) BvhNode {
-  float lo[3];
-  uint32_t offset;
-  float hi[3];
-  uint32_t count;
-
-  /// True for a leaf.
-  bool is_leaf() const { return count > 0; }
-  /// The node's box.
-  AABB box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
-};
-static_assert(sizeof(BvhNode) == 32, "BVH nodes are 32 bytes");
-
-/// Allocator aligning the node array to 64 bytes, so each sibling pair shares one cache line.
-template <class T>
-struct CacheLineAllocator {
-  using value_type = T;
-  CacheLineAllocator() = default;
-  template <class U>
-  CacheLineAllocator(const CacheLineAllocator<U>&) {}
-  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
-  void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(64)); }
-  bool operator==(const CacheLineAllocator&) const { return true; }
-};
-
-/// The node array of a BVH.
-using BvhNodeArray = std::vector<BvhNode, CacheLineAllocator<BvhNode>>;
 
 /// How a BVH chooses its splits.
 enum class BvhMethod {
@@ -68,9 +41,6 @@ struct BvhConfig {
   SahCosts costs;                    ///< SAH traversal and intersection costs
   size_t parallel_threshold = 4096;  ///< subtrees at least this large build their children in parallel
 };
-
-/// Largest allowed max_depth (the traversal stack holds one entry per level).
-inline constexpr int kBvhMaxDepth = 120;
 
 /// What the builder produces: the node array, the leaf order of primitive ids and the statistics
 /// (nodes, leaves, depths, histogram, references, SAH cost; bytes are left to the structure).
@@ -136,13 +106,21 @@ class Bvh final : public AcceleratorBase<Bvh<P, M>> {
  public:
   /// Reads the Config from params; the build is separate (build()).
   Bvh(std::shared_ptr<const P> prims, Params& params)
-      : prims_(std::move(prims)), config_(read_bvh_config(M, params)), effective_(params.effective()) {}
+      : prims_(std::move(prims)), config_(read_bvh_config(M, params)), width_(read_width(params)),
+        effective_(params.effective()) {
+    // Wide leaves test triangles four at a time, so the SAH prices a leaf by its blocks of four.
+    if (width_ == 8 && kCopiesTriangles) config_.costs.block = 4;
+  }
 
   std::string name() const override { return bvh_method_name(M); }
   nlohmann::json config() const override { return effective_; }
   AABB bounds() const override { return prims_->bounds(); }
-  /// The flattened nodes (for tests).
+  /// The flattened binary nodes (empty for width 8, whose build frees them; for tests).
   const BvhNodeArray& nodes() const { return nodes_; }
+  /// The 8-wide nodes (empty for width 2; for tests).
+  const Bvh8NodeArray& wide_nodes() const { return wide_; }
+  /// Original ids of the wide leaves' triangle block lanes (kInvalidId for padding; for tests).
+  const std::vector<uint32_t>& block_ids() const { return block_ids_; }
   /// Primitive ids in leaf order (for tests).
   const std::vector<uint32_t>& order() const { return order_; }
 
@@ -150,6 +128,15 @@ class Bvh final : public AcceleratorBase<Bvh<P, M>> {
   /// strictly greater than best.t (the box test's upper bound is min(tmax, best.t)).
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+    if (width_ == 8) {
+      if (wide_.empty()) return;
+      const LeafRay leaf_ray(ray);
+      walk_bvh8<kCount, true>(
+          wide_.data(), ray, [&] { return std::min(ray.tmax, best.t); },
+          [&](uint32_t first, uint32_t count) { return wide_leaf<kCount, false>(first, count, ray, leaf_ray, &best, inst, c); },
+          leaf_data(), sizeof(Triangle4), c);
+      return;
+    }
     if (nodes_.empty()) return;
     const BvhPairTest test(ray);
     const BvhNode* nodes = nodes_.data();
@@ -195,6 +182,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, M>> {
   /// Any hit within [tmin, tmax]: stops at the first primitive that reports one.
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
+    if (width_ == 8) {
+      if (wide_.empty()) return false;
+      const LeafRay leaf_ray(ray);
+      return walk_bvh8<kCount, false>(
+          wide_.data(), ray, [&] { return ray.tmax; },
+          [&](uint32_t first, uint32_t count) { return wide_leaf<kCount, true>(first, count, ray, leaf_ray, nullptr, 0, c); },
+          leaf_data(), sizeof(Triangle4), c);
+    }
     if (nodes_.empty()) return false;
     const BvhPairTest test(ray);
     const BvhNode* nodes = nodes_.data();
@@ -243,23 +238,102 @@ class Bvh final : public AcceleratorBase<Bvh<P, M>> {
     nodes_ = std::move(result.nodes);
     order_ = std::move(result.order);
     this->stats_ = std::move(result.stats);
-    this->stats_.bytes = nodes_.size() * sizeof(BvhNode) + order_.size() * sizeof(uint32_t);
-    if constexpr (kCopiesTriangles) {
-      tris_.resize(order_.size());
-      for (size_t k = 0; k < order_.size(); ++k) tris_[k] = prims_->triangle(order_[k]);
-      this->stats_.bytes += tris_.size() * sizeof(Triangle);
+    this->stats_.extra["width"] = width_;
+    if (width_ == 8) {
+      wide_ = collapse_to_bvh8(nodes_, this->stats_);
+      BvhNodeArray().swap(nodes_);
     }
+    if constexpr (kCopiesTriangles) {
+      if (width_ == 8) {
+        pack_leaf_blocks();
+      } else {
+        tris_.resize(order_.size());
+        for (size_t k = 0; k < order_.size(); ++k) tris_[k] = prims_->triangle(order_[k]);
+      }
+    }
+    this->stats_.bytes = nodes_.size() * sizeof(BvhNode) + wide_.size() * sizeof(Bvh8Node) +
+                         order_.size() * sizeof(uint32_t) + tris_.size() * sizeof(Triangle) +
+                         blocks_.size() * sizeof(Triangle4) + block_ids_.size() * sizeof(uint32_t);
   }
 
  private:
   static constexpr bool kCopiesTriangles = std::is_same_v<P, TrianglePrims>;
+
+  /// What a wide leaf is tested with: the ray broadcast to four lanes for triangle blocks, else the ray.
+  using LeafRay = std::conditional_t<kCopiesTriangles, Ray4, Ray>;
+
+  /// The wide tree's triangle blocks as bytes for prefetching (null for other primitive sets).
+  const char* leaf_data() const { return blocks_.empty() ? nullptr : reinterpret_cast<const char*>(blocks_.data()); }
+
+  /// Replaces each wide leaf's primitive range by blocks of four triangles (Embree's Triangle4 layout):
+  /// lane child = first block, count unchanged; ids per lane (kInvalidId for padding). order_ is then
+  /// no longer needed.
+  void pack_leaf_blocks() {
+    for (Bvh8Node& node : wide_) {
+      for (int k = 0; k < Bvh8Node::kWidth; ++k) {
+        if (node.count[k] == 0) continue;
+        const uint32_t first = node.child[k], n = node.count[k];
+        node.child[k] = uint32_t(blocks_.size());
+        for (uint32_t s = 0; s < n; s += 4) {
+          Triangle quad[4];
+          const uint32_t m = std::min(4u, n - s);
+          for (uint32_t j = 0; j < 4; ++j) {
+            if (j < m) quad[j] = prims_->triangle(order_[first + s + j]);
+            block_ids_.push_back(j < m ? order_[first + s + j] : kInvalidId);
+          }
+          blocks_.push_back(Triangle4::pack(std::span<const Triangle>(quad, m)));
+        }
+      }
+    }
+    std::vector<uint32_t>().swap(order_);
+  }
+
+  /// Tests a wide leaf (`first`, `count` as stored in its lane): triangle blocks four at a time with the
+  /// one kernel, other primitives one by one. kAny: returns true at the first hit; otherwise updates *best
+  /// and returns false.
+  template <bool kCount, bool kAny>
+  [[gnu::always_inline]] bool wide_leaf(uint32_t first, uint32_t count, const Ray& ray, const LeafRay& leaf_ray,
+                                        Hit* best, uint32_t inst, RayCounters& c) const {
+    if constexpr (kCopiesTriangles) {
+      if constexpr (kCount) c.prims += count;
+      for (uint32_t b = first, e = first + (count + 3) / 4; b < e; ++b) {
+        alignas(16) float t[4], u[4], v[4];
+        unsigned mask = intersect_triangle4(leaf_ray, blocks_[b], t, u, v);
+        if constexpr (kAny) {
+          if (mask) return true;
+        } else {
+          for (; mask; mask &= mask - 1) {
+            const int j = std::countr_zero(mask);
+            accept_hit({t[j], u[j], v[j]}, block_ids_[4 * b + j], inst, *best);
+          }
+        }
+      }
+    } else {
+      for (uint32_t k = first, e = first + count; k < e; ++k) {
+        if constexpr (kAny) {
+          if (prims_->template occluded<kCount>(order_[k], ray, c)) return true;
+        } else {
+          prims_->template intersect<kCount>(order_[k], ray, *best, inst, c);
+        }
+      }
+    }
+    return false;
+  }
+
+  /// Node width: 2 (the binary tree) or 8 (collapsed); bvh-sah defaults to 8, the others to 2.
+  static int read_width(Params& params) {
+    const int w = int(params.get_int("width", M == BvhMethod::kBinnedSah ? 8 : 2, 2, 8));
+    if (w != 2 && w != 8) throw ParamError("parameter 'width': " + std::to_string(w) + " is not 2 or 8");
+    return w;
+  }
 
   /// Tests the k-th primitive of leaf order with the one kernel and the original id.
   template <bool kCount>
   [[gnu::always_inline]] void intersect_leaf_prim(uint32_t k, const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
     if constexpr (kCopiesTriangles) {
       if constexpr (kCount) ++c.prims;
-      intersect_and_update(ray, tris_[k], order_[k], inst, best);
+      TriangleHit th;  // the id (another cache line) is read only for a hit
+      if (intersect_triangle(ray, tris_[k], th)) accept_hit(th, order_[k], inst, best);
     } else {
       prims_->template intersect<kCount>(order_[k], ray, best, inst, c);
     }
@@ -278,10 +352,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, M>> {
 
   std::shared_ptr<const P> prims_;
   BvhConfig config_;
+  int width_;
   nlohmann::json effective_;
   BvhNodeArray nodes_;
+  Bvh8NodeArray wide_;
   std::vector<uint32_t> order_;
-  std::vector<Triangle> tris_;  ///< triangles in leaf order (TrianglePrims only)
+  std::vector<Triangle> tris_;  ///< triangles in leaf order (TrianglePrims, width 2)
+  std::vector<Triangle4> blocks_;     ///< wide leaves' triangles, four per block (TrianglePrims, width 8)
+  std::vector<uint32_t> block_ids_;   ///< original id of each block lane (kInvalidId for padding)
 };
 
 /// Object-median BVH (registered as bvh-median).

@@ -37,6 +37,8 @@ TEST(Bvh, MatchesBruteOnAdversarialMesh) {
     EXPECT_EQ(count_differences(name, mesh, rays, {{"max_depth", "2"}}), 0u) << name << " depth-limited";
   }
   EXPECT_EQ(count_differences("bvh-sah", mesh, rays, {{"bins", "2"}, {"max_leaf_size", "1"}}), 0u);
+  EXPECT_EQ(count_differences("bvh-sah", mesh, rays, {{"width", "2"}}), 0u) << "binary bvh-sah";
+  EXPECT_EQ(count_differences("bvh-median", mesh, rays, {{"width", "8"}}), 0u) << "wide bvh-median";
 }
 
 TEST(Bvh, EmptyAndSingleTriangle) {
@@ -73,7 +75,7 @@ TEST(Bvh, AllDuplicatesSplitsToLeafSize) {
 /// Structural invariants: depth-first layout, children inside parents, leaves cover a permutation.
 template <BvhMethod M>
 void check_structure(const Mesh& mesh) {
-  Params params;
+  Params params = testing::make_params({{"width", "2"}});
   Bvh<TrianglePrims, M> bvh(prims_of(mesh), params);
   bvh.build();
   const auto& nodes = bvh.nodes();
@@ -124,8 +126,8 @@ TEST(Bvh, MedianLeafSizeIsRespected) {
 
 TEST(Bvh, BinnedSahIsCloseToSweepAndBetterThanMedian) {
   const Mesh mesh = random_soup(20000, 13, 0.02f);
-  auto cost = [&](const char* name) {
-    auto bvh = make_accelerator(name, prims_of(mesh), Params());
+  auto cost = [&](const char* name) {  // binary trees priced per triangle, as the sweep's
+    auto bvh = make_accelerator(name, prims_of(mesh), testing::make_params({{"width", "2"}}));
     bvh->build();
     return bvh->stats().sah_cost;
   };
@@ -138,12 +140,13 @@ TEST(Bvh, SameTreeForAnyThreadCount) {
   const Mesh mesh = random_soup(150000, 17, 0.01f);  // above the parallel thresholds
   auto build_in = [&](int threads) {
     tbb::task_arena arena(threads);
-    Params params;
+    Params params = testing::make_params({{"width", "2"}});
     auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh), params);
     arena.execute([&] { bvh->build(); });
     return bvh;
   };
   const auto one = build_in(1), two = build_in(2);
+  ASSERT_FALSE(one->nodes().empty());
   ASSERT_EQ(one->nodes().size(), two->nodes().size());
   EXPECT_EQ(std::memcmp(one->nodes().data(), two->nodes().data(), one->nodes().size() * sizeof(BvhNode)), 0);
   EXPECT_EQ(one->order(), two->order());

@@ -1,0 +1,191 @@
+// The 8-wide BVH: its SIMD box test against the scalar one, the four-lane kernel against the scalar
+// kernel (bit for bit), the collapsed tree's invariants and its thread independence.
+#include "accel/bvh.h"
+#include "accel/bvh_wide.h"
+#include "accel/triangle4.h"
+#include "tests/structure_test_helpers.h"
+
+#include <tbb/task_arena.h>
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstring>
+#include <random>
+
+namespace ab {
+namespace {
+
+using testing::adversarial_mesh;
+using testing::adversarial_rays;
+using testing::random_soup;
+using testing::uniform;
+
+std::shared_ptr<const TrianglePrims> prims_of(const Mesh& m) {
+  return std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(m));
+}
+
+uint32_t bits(float f) { return std::bit_cast<uint32_t>(f); }
+
+/// Random rays with awkward directions: zero and -0 components, axis-parallel, tiny and huge.
+Ray awkward_ray(std::mt19937& rng) {
+  Ray r;
+  r.org = {uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)};
+  for (int a = 0; a < 3; ++a) {
+    const uint32_t pick = rng() % 8;
+    r.dir[a] = pick == 0 ? 0.0f : pick == 1 ? -0.0f : pick == 2 ? 1e-30f : uniform(rng, -1, 1);
+    if (rng() % 6 == 0) r.org[a] = std::round(r.org[a]);  // origin on a box plane
+  }
+  r.tmin = rng() % 4 == 0 ? uniform(rng, 0, 1) : 0.0f;
+  r.tmax = rng() % 4 == 0 ? uniform(rng, 0, 3) : kInf;
+  return r;
+}
+
+TEST(Bvh8, SimdBoxTestEqualsTheScalarOneLaneByLane) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20000; ++trial) {
+    Bvh8Node node;
+    for (int k = 0; k < 8; ++k) {
+      const bool empty = rng() % 7 == 0;
+      for (int a = 0; a < 3; ++a) {
+        float lo = std::round(uniform(rng, -2, 2) * 4) / 4, hi = lo + (rng() % 3 == 0 ? 0.0f : uniform(rng, 0, 2));
+        node.bounds[a][k] = empty ? kInf : lo;
+        node.bounds[3 + a][k] = empty ? -kInf : hi;
+      }
+      node.child[k] = node.count[k] = 0;
+    }
+    const Ray ray = awkward_ray(rng);
+    const Bvh8RayTest test(ray);
+    const float limit = rng() % 2 ? ray.tmax : std::min(ray.tmax, uniform(rng, 0, 2));  // as the walk passes it
+    alignas(32) float simd[8], scalar[8];
+    const unsigned m1 = test.entries(node, limit, simd), m2 = test.entries_scalar(node, limit, scalar);
+    ASSERT_EQ(m1, m2) << "trial " << trial;
+    for (int k = 0; k < 8; ++k) {
+      if (m1 >> k & 1) {
+        ASSERT_EQ(bits(simd[k]) & 0x7fffffffu, bits(scalar[k]) & 0x7fffffffu) << trial;
+      }
+      // A lane entered by the wide test is entered by the binary test's arithmetic too.
+      if (!node.used(k)) {
+        EXPECT_FALSE(m1 >> k & 1);
+      }
+      float t0 = ray.tmin, t1 = limit;
+      ASSERT_EQ(bool(m1 >> k & 1), node.used(k) && slab_test(node.box(k), RayBoxData(ray), t0, t1))
+          << trial << " lane " << k << " org " << ray.org.x << "," << ray.org.y << "," << ray.org.z << " dir "
+          << ray.dir.x << "," << ray.dir.y << "," << ray.dir.z << " t " << ray.tmin << ".." << ray.tmax << " limit " << limit
+          << " box " << node.box(k).lo.x << "," << node.box(k).lo.y << "," << node.box(k).lo.z << " - " << node.box(k).hi.x
+          << "," << node.box(k).hi.y << "," << node.box(k).hi.z << " entry " << simd[k];
+    }
+  }
+}
+
+TEST(Bvh8, FourLaneKernelGivesTheScalarKernelsBits) {
+  const Mesh mesh = adversarial_mesh(6);
+  std::vector<Triangle> tris;
+  for (size_t i = 0; i < mesh.size(); ++i) tris.push_back(mesh.triangle(i));
+  const Mesh soup = random_soup(400, 5, 0.5f);
+  for (size_t i = 0; i < soup.size(); ++i) tris.push_back(soup.triangle(i));
+  std::vector<Ray> rays = adversarial_rays(mesh, 1500, 9);
+  const auto more = adversarial_rays(soup, 1500, 10);
+  rays.insert(rays.end(), more.begin(), more.end());
+  size_t hits = 0;
+  for (size_t first = 0; first < tris.size(); first += 3) {  // overlapping groups, the last one partial
+    const size_t n = std::min<size_t>(4, tris.size() - first);
+    const Triangle4 quad = Triangle4::pack(std::span<const Triangle>(tris.data() + first, n));
+    for (size_t r = first % 7; r < rays.size(); r += 5) {
+      const Ray4 ray4(rays[r]);
+      alignas(16) float t[4], u[4], v[4];
+      const unsigned mask = intersect_triangle4(ray4, quad, t, u, v);
+      for (size_t j = 0; j < 4; ++j) {
+        TriangleHit th{};
+        const bool scalar = j < n && intersect_triangle(rays[r], tris[first + j], th);
+        ASSERT_EQ(bool(mask >> j & 1), scalar) << "triangle " << first + j << " ray " << r;
+        if (!scalar) continue;
+        ++hits;
+        EXPECT_EQ(bits(t[j]), bits(th.t));
+        EXPECT_EQ(bits(u[j]), bits(th.u));
+        EXPECT_EQ(bits(v[j]), bits(th.v));
+      }
+    }
+  }
+  EXPECT_GT(hits, 1000u);  // the comparison saw real hits
+}
+
+/// Invariants of the collapsed tree: lanes hold boxes that contain their children's boxes or their
+/// triangles, every triangle sits in exactly one block lane, nodes have 2..8 children.
+TEST(Bvh8, CollapsedTreeInvariants) {
+  const Mesh mesh = random_soup(5000, 21);
+  Params params;
+  BvhSah<TrianglePrims> bvh(prims_of(mesh), params);
+  bvh.build();
+  const auto& wide = bvh.wide_nodes();
+  ASSERT_FALSE(wide.empty());
+  EXPECT_TRUE(bvh.nodes().empty());  // the binary tree is freed
+  EXPECT_EQ(reinterpret_cast<uintptr_t>(wide.data()) % 64, 0u);
+  std::vector<int> seen(mesh.size(), 0);
+  uint64_t lanes = 0, leaves = 0;
+  for (size_t i = 0; i < wide.size(); ++i) {
+    int used = 0;
+    for (int k = 0; k < 8; ++k) {
+      if (!wide[i].used(k)) continue;
+      ++used;
+      const AABB box = wide[i].box(k);
+      if (wide[i].count[k] == 0) {
+        const uint32_t c = wide[i].child[k];
+        ASSERT_GT(c, i);
+        ASSERT_LT(c, wide.size());
+        for (int j = 0; j < 8; ++j)
+          if (wide[c].used(j)) {
+            ASSERT_TRUE(box.contains(wide[c].box(j).lo) && box.contains(wide[c].box(j).hi));
+          }
+        continue;
+      }
+      ++leaves;
+      for (uint32_t s = 0; s < wide[i].count[k]; ++s) {
+        const uint32_t id = bvh.block_ids()[4 * wide[i].child[k] + s];
+        ASSERT_LT(id, mesh.size());
+        ++seen[id];
+        const AABB tb = mesh.triangle(id).bounds();
+        EXPECT_TRUE(box.contains(tb.lo) && box.contains(tb.hi));
+      }
+    }
+    EXPECT_GE(used, i == 0 ? 1 : 2);
+    lanes += uint64_t(used);
+  }
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+  EXPECT_EQ(bvh.stats().leaves, leaves);
+  EXPECT_EQ(bvh.stats().nodes, wide.size() + leaves);
+  EXPECT_EQ(bvh.stats().references, mesh.size());
+  EXPECT_GT(double(lanes) / double(wide.size()), 3.0);  // the collapse fills nodes
+  EXPECT_LT(bvh.stats().max_depth, bvh.stats().extra["binary_max_depth"].get<uint32_t>());
+}
+
+TEST(Bvh8, SameWideTreeForAnyThreadCount) {
+  const Mesh mesh = random_soup(150000, 17, 0.01f);
+  auto build_in = [&](int threads) {
+    tbb::task_arena arena(threads);
+    Params params;
+    auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh), params);
+    arena.execute([&] { bvh->build(); });
+    return bvh;
+  };
+  const auto one = build_in(1), two = build_in(2);
+  ASSERT_FALSE(one->wide_nodes().empty());
+  ASSERT_EQ(one->wide_nodes().size(), two->wide_nodes().size());
+  EXPECT_EQ(std::memcmp(one->wide_nodes().data(), two->wide_nodes().data(), one->wide_nodes().size() * sizeof(Bvh8Node)), 0);
+  EXPECT_EQ(one->block_ids(), two->block_ids());
+}
+
+TEST(Bvh8, WidthIsTwoOrEight) {
+  const auto prims = prims_of(random_soup(10, 1));
+  EXPECT_THROW(make_accelerator("bvh-sah", prims, testing::make_params({{"width", "4"}})), ParamError);
+  EXPECT_THROW(make_accelerator("bvh-sah", prims, testing::make_params({{"width", "16"}})), ParamError);
+  auto two = make_accelerator("bvh-sah", prims, testing::make_params({{"width", "2"}}));
+  two->build();
+  EXPECT_EQ(two->stats().extra["width"], 2);
+  auto eight = make_accelerator("bvh-sah", prims, Params());
+  eight->build();
+  EXPECT_EQ(eight->stats().extra["width"], 8);
+}
+
+}  // namespace
+}  // namespace ab
