@@ -4,12 +4,15 @@
 #pragma once
 
 #include "accel/geometry.h"
+#include "accel/primitives.h"
 #include "accel/stats.h"
+#include "accel/triangle.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace ab {
@@ -150,6 +153,65 @@ bool occluded_id_list(const P& prims, const uint32_t* ids, uint32_t count, const
     if (prims.template occluded<kCount>(ids[k], ray, c)) return true;
   return false;
 }
+
+/// The leaves' primitive references in leaf order: the original ids and, for triangle sets, a copy of each
+/// referenced triangle in the same order, so that a leaf reads its triangles from one contiguous run (as the
+/// BVH's leaves do) instead of gathering them by id. A triangle referenced by several leaves is copied once
+/// per reference. Other primitive sets (instances) are reached through their ids.
+template <class P>
+class LeafRefs {
+ public:
+  /// True when triangles are copied into leaf order.
+  static constexpr bool kCopies = std::is_same_v<P, TrianglePrims>;
+
+  /// Takes the leaf-ordered ids and copies the triangles they name.
+  void assign(const P& prims, std::vector<uint32_t> ids) {
+    ids_ = std::move(ids);
+    if constexpr (kCopies) {
+      tris_.resize(ids_.size());
+      for (size_t k = 0; k < ids_.size(); ++k) tris_[k] = prims.triangle(ids_[k]);
+    }
+  }
+  /// The leaf-ordered ids.
+  const std::vector<uint32_t>& ids() const { return ids_; }
+  /// Memory of the ids and copies.
+  size_t bytes() const { return ids_.size() * sizeof(uint32_t) + tris_.size() * sizeof(Triangle); }
+
+  /// Closest hit over references [first, first + count): the one kernel with the original ray and ids.
+  template <bool kCount>
+  [[gnu::always_inline]] void intersect(const P& prims, uint32_t first, uint32_t count, const Ray& ray, Hit& best,
+                                        uint32_t inst, RayCounters& c) const {
+    if constexpr (kCopies) {
+      if constexpr (kCount) c.prims += count;
+      for (uint32_t k = first, e = first + count; k < e; ++k) {
+        TriangleHit th;  // the id (another array) is read only for a hit
+        if (intersect_triangle(ray, tris_[k], th) && is_better_hit(th.t, inst, ids_[k], best))
+          best = {th.t, ids_[k], inst, th.u, th.v};
+      }
+    } else {
+      intersect_id_list<kCount>(prims, ids_.data() + first, count, ray, best, inst, c);
+    }
+  }
+  /// True when any reference in [first, first + count) blocks the ray.
+  template <bool kCount>
+  [[gnu::always_inline]] bool occluded(const P& prims, uint32_t first, uint32_t count, const Ray& ray,
+                                       RayCounters& c) const {
+    if constexpr (kCopies) {
+      for (uint32_t k = first, e = first + count; k < e; ++k) {
+        if constexpr (kCount) ++c.prims;
+        TriangleHit th;
+        if (intersect_triangle(ray, tris_[k], th)) return true;
+      }
+      return false;
+    } else {
+      return occluded_id_list<kCount>(prims, ids_.data() + first, count, ray, c);
+    }
+  }
+
+ private:
+  std::vector<uint32_t> ids_;
+  std::vector<Triangle> tris_;
+};
 
 /// Default depth limit of the k-d builders: 8 + 1.3 log2 N (Havran 2000; pbrt).
 inline int auto_kd_depth(size_t n) { return int(std::lround(8.0 + 1.3 * std::log2(double(std::max<size_t>(n, 1))))); }

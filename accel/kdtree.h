@@ -46,47 +46,25 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   /// Closest hit: front-to-back traversal with a stack of far children.
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
-    float t0 = ray.tmin, t1 = ray.tmax;
-    if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return;
-    const RayAxes axes(ray);
-    StackItem stack[kStackSize];
-    int sp = 0;
-    uint32_t node = 0;
-    while (true) {
-      const KdNode& n = nodes_[node];
-      if constexpr (kCount) ++c.nodes;
-      if (!n.is_leaf()) {
-        if (step(n, node, axes, t0, t1, stack, sp)) continue;
-      } else {
-        if constexpr (kCount) ++c.leaves;
-        intersect_id_list<kCount>(*prims_, &prims_ids_[n.first()], n.count(), ray, best, inst, c);
-      }
-      if (!pop(stack, sp, best.t, node, t0, t1)) return;
-    }
+    if (!unbounded_.empty())
+      intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
+    traverse<kCount>(
+        ray, c,
+        [&](uint32_t first, uint32_t count) {
+          leaves_.template intersect<kCount>(*prims_, first, count, ray, best, inst, c);
+          return false;
+        },
+        [&] { return best.t; });
   }
 
   /// Any hit: the same traversal, stopping at the first primitive that blocks the ray.
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
     if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
-    float t0 = ray.tmin, t1 = ray.tmax;
-    if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
-    const RayAxes axes(ray);
-    StackItem stack[kStackSize];
-    int sp = 0;
-    uint32_t node = 0;
-    while (true) {
-      const KdNode& n = nodes_[node];
-      if constexpr (kCount) ++c.nodes;
-      if (!n.is_leaf()) {
-        if (step(n, node, axes, t0, t1, stack, sp)) continue;
-      } else {
-        if constexpr (kCount) ++c.leaves;
-        if (occluded_id_list<kCount>(*prims_, &prims_ids_[n.first()], n.count(), ray, c)) return true;
-      }
-      if (!pop(stack, sp, kInf, node, t0, t1)) return false;
-    }
+    return traverse<kCount>(
+        ray, c,
+        [&](uint32_t first, uint32_t count) { return leaves_.template occluded<kCount>(*prims_, first, count, ray, c); },
+        [] { return kInf; });
   }
 
  protected:
@@ -110,7 +88,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       }
     }
     nodes_ = std::move(out.nodes);
-    prims_ids_ = std::move(out.prims);
+    leaves_.assign(*prims_, std::move(out.prims));
     fill_stats(depth);
   }
 
@@ -121,46 +99,58 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   };
   static constexpr int kStackSize = 128;
 
-  /// One interior node: continues into the first child met (pushing the second) and returns true, or
-  /// returns false when neither child overlaps the interval.
-  [[gnu::always_inline]] bool step(const KdNode& n, uint32_t& node, const RayAxes& r, float& t0, float& t1, StackItem* stack,
-            int& sp) const {
-    const int a = n.axis();
-    const PlaneVisit v = split_at_axis_plane(r.org[a], r.dir[a], r.inv[a], n.split(), t0, t1);
-    const uint32_t first = v.first_below ? node + 1 : n.above();
-    const uint32_t second = v.first_below ? n.above() : node + 1;
-    if (v.visit_first) {
-      if (v.visit_second) stack[sp++] = {second, v.second_t0, t1};
-      node = first;
-      t1 = v.first_t1;
-      return true;
+  /// Front-to-back traversal (Havran 2000, TA_B rec, in the tight form of pbrt's KdTreeAggregate): at an
+  /// interior node the ray interval [t0, t1] is split at the plane's widened crossing (AxisRay), the
+  /// first child continues and the second, when the interval reaches it, goes on the stack. leaf(first,
+  /// count) returns true to stop (any hit); an entry is popped only when its t0 is not beyond best_t().
+  template <bool kCount, class Leaf, class BestT>
+  [[gnu::always_inline]] bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
+    float t0 = ray.tmin, t1 = ray.tmax;
+    if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
+    const AxisRay r(ray);
+    const KdNode* nodes = nodes_.data();
+    StackItem stack[kStackSize];
+    int sp = 0;
+    uint32_t idx = 0;
+    for (;;) {
+      KdNode n = nodes[idx];
+      while (!n.is_leaf()) {
+        if constexpr (kCount) ++c.nodes;
+        const AxisCrossing x = r.cross(n.axis(), n.split());
+        const uint32_t below = idx + 1, above = n.above();
+        const uint32_t first = x.below_first ? below : above;
+        const uint32_t second = x.below_first ? above : below;
+        if (x.near > t1) {
+          idx = first;
+        } else if (x.far < t0) {
+          idx = second;
+        } else {
+          stack[sp++] = {second, std::max(t0, x.near), t1};
+          t1 = std::min(t1, x.far);
+          idx = first;
+        }
+        n = nodes[idx];
+      }
+      if constexpr (kCount) {
+        ++c.nodes;
+        ++c.leaves;
+      }
+      if (n.count() && leaf(n.first(), n.count())) return true;
+      const float limit = best_t();
+      do {
+        if (sp == 0) return false;
+        --sp;
+      } while (stack[sp].t0 > limit);
+      idx = stack[sp].node;
+      t0 = stack[sp].t0;
+      t1 = stack[sp].t1;
     }
-    if (v.visit_second) {
-      node = second;
-      t0 = v.second_t0;
-      return true;
-    }
-    return false;
-  }
-
-  /// Next node from the stack whose entry is not beyond best_t (strictly); false when none is left.
-  [[gnu::always_inline]] static bool pop(const StackItem* stack, int& sp, float best_t, uint32_t& node, float& t0, float& t1) {
-    while (sp > 0) {
-      const StackItem& it = stack[--sp];
-      if (it.t0 > best_t) continue;
-      node = it.node;
-      t0 = it.t0;
-      t1 = it.t1;
-      return true;
-    }
-    return false;
   }
 
   void fill_stats(int depth_limit) {
     BuildStats& st = this->stats_;
     st.nodes = nodes_.size();
-    st.bytes = nodes_.size() * sizeof(KdNode) + prims_ids_.size() * sizeof(uint32_t) +
-               unbounded_.size() * sizeof(uint32_t);
+    st.bytes = nodes_.size() * sizeof(KdNode) + leaves_.bytes() + unbounded_.size() * sizeof(uint32_t);
     st.extra["depth_limit"] = depth_limit;
     st.extra["unbounded_primitives"] = unbounded_.size();
     if (nodes_.empty()) return;
@@ -199,7 +189,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   nlohmann::json config_;
   AABB box_;
   std::vector<KdNode> nodes_;
-  std::vector<uint32_t> prims_ids_;
+  LeafRefs<P> leaves_;
   std::vector<uint32_t> unbounded_;
 };
 

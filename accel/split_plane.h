@@ -67,4 +67,34 @@ struct RayAxes {
   return split_interval(org - split, dir, t_split, std::fabs(t_split) * kBoxEps, 0.0f, t0, t1);
 }
 
+/// Where a ray crosses an axis-aligned plane: the widened crossing distances (near <= far, both NaN for a
+/// ray lying in the plane) and which side it meets first.
+struct AxisCrossing {
+  float near, far;   ///< widen_near(t_split), widen_far(t_split)
+  bool below_first;  ///< the below side comes first (direction's sign bit clear)
+};
+
+/// A ray prepared for many axis-aligned plane steps (the k-d tree's inner loop, after pbrt's
+/// KdTreeAggregate): origin, reciprocal direction and the side met first, per axis. The step is the
+/// same as split_at_axis_plane but written for a tight loop: the near side comes from the sign bit
+/// of the direction, so a zero component (t_split = +-inf, or NaN when the origin lies in the plane)
+/// needs no branch: +-inf keeps the ray on its side, and NaN makes both comparisons false, so both
+/// sides are visited over the whole interval (std::max(t0, NaN) is t0 and std::min(t1, NaN) is t1).
+struct AxisRay {
+  float org[3], inv[3];
+  bool below_first[3];
+
+  /// From ray r.
+  explicit AxisRay(const Ray& r)
+      : org{r.org.x, r.org.y, r.org.z},
+        inv{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z},
+        below_first{!std::signbit(r.dir.x), !std::signbit(r.dir.y), !std::signbit(r.dir.z)} {}
+
+  /// The crossing of plane coordinate `split` on axis a.
+  [[gnu::always_inline]] AxisCrossing cross(int a, float split) const {
+    const float t = (split - org[a]) * inv[a];
+    return {widen_near(t), widen_far(t), below_first[a]};
+  }
+};
+
 }  // namespace ab
