@@ -3,6 +3,8 @@
 // Sizes from the environment: ACCELBENCH_MICRO_TRIANGLES (default 100000), ACCELBENCH_MICRO_RAYS (100000).
 // Filter with --benchmark_filter, e.g. 'Trace/sphereflake/.*/(bvh-sah|embree)'.
 #include "accel/bvh.h"
+#include "accel/bvh_wide.h"
+#include "accel/triangle4.h"
 #include "accel/geometry.h"
 #include "accel/registry.h"
 #include "accel/triangle.h"
@@ -91,6 +93,49 @@ void BM_RayTriangle(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_RayTriangle);
+
+void BM_Bvh8BoxTest(benchmark::State& state) {
+  const auto rays = random_rays(1024, 5);
+  std::vector<Bvh8RayTest> tests;
+  for (const Ray& r : rays) tests.emplace_back(r);
+  Bvh8Node node;
+  for (int k = 0; k < 8; ++k) {
+    for (int a = 0; a < 3; ++a) node.bounds[a][k] = 0.25f * float(k) * (a == 0), node.bounds[3 + a][k] = 1.0f + 0.25f * float(k) * (a == 0);
+    node.child[k] = node.count[k] = 0;
+  }
+  alignas(32) float t[8];
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(tests[i++ & 1023].entries(node, kInf, t));
+    benchmark::DoNotOptimize(t);
+  }
+  state.SetItemsProcessed(state.iterations() * 8);  // boxes
+}
+BENCHMARK(BM_Bvh8BoxTest);
+
+void BM_RayTriangle4(benchmark::State& state) {
+  const auto rays = random_rays(1024, 3);
+  std::mt19937 rng(4);
+  std::vector<Triangle4> quads(256);
+  for (Triangle4& q : quads) {
+    Triangle tris[4];
+    for (Triangle& t : tris)
+      t = {{uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)},
+           {uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)},
+           {uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)}};
+    q = Triangle4::pack(tris);
+  }
+  std::vector<Ray4> ray4;
+  for (const Ray& r : rays) ray4.emplace_back(r);
+  alignas(16) float t[4], u[4], v[4];
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(intersect_triangle4(ray4[i & 1023], quads[(i * 7) & 255], t, u, v));
+    ++i;
+  }
+  state.SetItemsProcessed(state.iterations() * 4);  // triangles
+}
+BENCHMARK(BM_RayTriangle4);
 
 /// Generated meshes and their ray sets, made once per process.
 struct Workload {
