@@ -138,18 +138,23 @@ TEST(Bvh, BinnedSahIsCloseToSweepAndBetterThanMedian) {
 
 TEST(Bvh, SameTreeForAnyThreadCount) {
   const Mesh mesh = random_soup(150000, 17, 0.01f);  // above the parallel thresholds
-  auto build_in = [&](int threads) {
-    tbb::task_arena arena(threads);
-    Params params = testing::make_params({{"width", "2"}});
-    auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh), params);
-    arena.execute([&] { bvh->build(); });
-    return bvh;
-  };
-  const auto one = build_in(1), two = build_in(2);
-  ASSERT_FALSE(one->nodes().empty());
-  ASSERT_EQ(one->nodes().size(), two->nodes().size());
-  EXPECT_EQ(std::memcmp(one->nodes().data(), two->nodes().data(), one->nodes().size() * sizeof(BvhNode)), 0);
-  EXPECT_EQ(one->order(), two->order());
+  for (const char* width : {"2", "8"}) {
+    auto build_in = [&](int threads) {
+      tbb::task_arena arena(threads);
+      Params params = testing::make_params({{"width", width}});
+      auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh), params);
+      arena.execute([&] { bvh->build(); });
+      return bvh;
+    };
+    const auto one = build_in(1), two = build_in(2);
+    ASSERT_FALSE(one->nodes().empty() && one->wide_nodes().empty()) << width;
+    ASSERT_EQ(one->nodes().size(), two->nodes().size());
+    EXPECT_EQ(std::memcmp(one->nodes().data(), two->nodes().data(), one->nodes().size() * sizeof(BvhNode)), 0);
+    ASSERT_EQ(one->wide_nodes().size(), two->wide_nodes().size());
+    EXPECT_EQ(std::memcmp(one->wide_nodes().data(), two->wide_nodes().data(), one->wide_nodes().size() * sizeof(Bvh8Node)), 0);
+    EXPECT_EQ(one->order(), two->order());
+    EXPECT_EQ(one->block_ids(), two->block_ids());
+  }
 }
 
 TEST(Bvh, CountersAreFilledOnlyByTheCountingPass) {

@@ -5,8 +5,6 @@
 #include "accel/triangle4.h"
 #include "tests/structure_test_helpers.h"
 
-#include <tbb/task_arena.h>
-
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -157,22 +155,6 @@ TEST(Bvh8, CollapsedTreeInvariants) {
   EXPECT_EQ(bvh.stats().references, mesh.size());
   EXPECT_GT(double(lanes) / double(wide.size()), 3.0);  // the collapse fills nodes
   EXPECT_LT(bvh.stats().max_depth, bvh.stats().extra["binary_max_depth"].get<uint32_t>());
-}
-
-TEST(Bvh8, SameWideTreeForAnyThreadCount) {
-  const Mesh mesh = random_soup(150000, 17, 0.01f);
-  auto build_in = [&](int threads) {
-    tbb::task_arena arena(threads);
-    Params params;
-    auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh), params);
-    arena.execute([&] { bvh->build(); });
-    return bvh;
-  };
-  const auto one = build_in(1), two = build_in(2);
-  ASSERT_FALSE(one->wide_nodes().empty());
-  ASSERT_EQ(one->wide_nodes().size(), two->wide_nodes().size());
-  EXPECT_EQ(std::memcmp(one->wide_nodes().data(), two->wide_nodes().data(), one->wide_nodes().size() * sizeof(Bvh8Node)), 0);
-  EXPECT_EQ(one->block_ids(), two->block_ids());
 }
 
 TEST(Bvh8, WidthIsTwoOrEight) {

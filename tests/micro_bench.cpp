@@ -43,6 +43,12 @@ std::vector<Ray> random_rays(size_t n, uint32_t seed) {
   return rays;
 }
 
+Triangle random_triangle(std::mt19937& rng) {
+  auto corner = [&] { return vec3(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)); };
+  const vec3 a = corner(), b = corner(), c = corner();
+  return {a, b, c};
+}
+
 void BM_SlabTest(benchmark::State& state) {
   const auto rays = random_rays(1024, 1);
   std::vector<RayBoxData> data;
@@ -79,10 +85,7 @@ void BM_RayTriangle(benchmark::State& state) {
   const auto rays = random_rays(1024, 3);
   std::mt19937 rng(4);
   std::vector<Triangle> tris(1024);
-  for (Triangle& t : tris)
-    t = {{uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)},
-         {uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)},
-         {uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)}};
+  for (Triangle& t : tris) t = random_triangle(rng);
   size_t i = 0;
   Hit best;
   for (auto _ : state) {
@@ -119,10 +122,7 @@ void BM_RayTriangle4(benchmark::State& state) {
   std::vector<Triangle4> quads(256);
   for (Triangle4& q : quads) {
     Triangle tris[4];
-    for (Triangle& t : tris)
-      t = {{uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)},
-           {uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)},
-           {uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1)}};
+    for (Triangle& t : tris) t = random_triangle(rng);
     q = Triangle4::pack(tris);
   }
   std::vector<Ray4> ray4;
