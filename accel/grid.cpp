@@ -58,13 +58,6 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
   return g;
 }
 
-namespace {
-
-constexpr size_t kBlock = 2048;  // primitives per insertion block (fixed: the result is thread-independent)
-
-/// Margin covering the inflation of every cell box (inflate_for_insertion grows a box by 2^-18 of the
-/// largest of its extent and coordinates), so the candidate range of a primitive misses no cell whose
-/// inflated box it could touch.
 float insertion_margin(const GridLayout& g) {
   const vec3 e = g.box.extent();
   float scale = std::max({e.x, e.y, e.z});
@@ -72,37 +65,125 @@ float insertion_margin(const GridLayout& g) {
   return scale * 0x1p-17f;
 }
 
-/// Appends (cell, id) for every cell primitive id goes into.
-void insert_primitive(const GridLayout& g, uint32_t id, const AABB& b, float margin, const OverlapTest& overlaps,
-                      std::vector<uint64_t>& out) {
+namespace {
+
+constexpr size_t kBlock = 2048;  // primitives per insertion block (fixed: the result is thread-independent)
+
+/// Cell range [lo, hi] per axis of a box widened by margin.
+struct CellRange {
   int lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = g.cell_of(a, b.lo[a] - margin);
-    hi[a] = g.cell_of(a, b.hi[a] + margin);
+
+  CellRange(const GridLayout& g, const AABB& b, float margin) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = g.cell_of(a, b.lo[a] - margin);
+      hi[a] = g.cell_of(a, b.hi[a] + margin);
+    }
   }
-  // A range that is one cell thick on two axes needs no test: the primitive is connected, so it meets every
-  // slab its bounds span (a cell added only because of the margin is harmless, just one more reference).
-  const bool line = (lo[0] != hi[0]) + (lo[1] != hi[1]) + (lo[2] != hi[2]) <= 1;
-  for (int z = lo[2]; z <= hi[2]; ++z)
-    for (int y = lo[1]; y <= hi[1]; ++y)
-      for (int x = lo[0]; x <= hi[0]; ++x)
-        if (line || overlaps(id, inflate_for_insertion(g.cell_box(x, y, z))))
-          out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
+  /// True when the range is more than one cell thick on at most one axis.
+  bool is_line() const { return (lo[0] != hi[0]) + (lo[1] != hi[1]) + (lo[2] != hi[2]) <= 1; }
+};
+
+/// Appends every cell of range r (z, then y, then x ascending).
+void append_range(const GridLayout& g, const CellRange& r, uint32_t id, std::vector<uint64_t>& out) {
+  for (int z = r.lo[2]; z <= r.hi[2]; ++z)
+    for (int y = r.lo[1]; y <= r.hi[1]; ++y)
+      for (int x = r.lo[0]; x <= r.hi[0]; ++x) out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
+}
+
+/// A convex polygon: a triangle clipped by four axis planes has at most 7 vertices; the capacity leaves
+/// room for the extra crossings rounding can give a degenerate (zero-area) one, which never hits anyway.
+struct SlabPolygon {
+  static constexpr int kCapacity = 16;
+  vec3 v[kCapacity];
+  int n = 0;
+};
+
+/// Keeps the part of `in` with lo <= p[axis] <= hi (Sutherland and Hodgman 1974, two parallel planes in
+/// one pass over the edges).
+void clip_to_slab(const SlabPolygon& in, int axis, float lo, float hi, SlabPolygon& out) {
+  SlabPolygon tmp;
+  auto clip = [axis](const SlabPolygon& src, float plane, float sign, SlabPolygon& dst) {
+    dst.n = 0;
+    for (int i = 0; i < src.n; ++i) {
+      const vec3& a = src.v[i];
+      const vec3& b = src.v[i + 1 == src.n ? 0 : i + 1];
+      const float da = sign * (a[axis] - plane), db = sign * (b[axis] - plane);
+      if (da <= 0.0f && dst.n < SlabPolygon::kCapacity) dst.v[dst.n++] = a;
+      if (((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) && dst.n < SlabPolygon::kCapacity)
+        dst.v[dst.n++] = a + (da / (da - db)) * (b - a);
+    }
+  };
+  clip(in, hi, 1.0f, tmp);
+  clip(tmp, lo, -1.0f, out);
+}
+
+/// Range of polygon p's coordinates on an axis.
+void polygon_extent(const SlabPolygon& p, int axis, float& lo, float& hi) {
+  lo = kInf, hi = -kInf;
+  for (int i = 0; i < p.n; ++i) lo = std::min(lo, p.v[i][axis]), hi = std::max(hi, p.v[i][axis]);
+}
+
+// Triangle voxelization by slab and row clipping (the scan conversion of Akenine-Moller and Aila's
+// conservative voxelization, done with Sutherland-Hodgman clipping): for each z slab of the triangle's
+// cell range, clip the triangle to the slab widened by the margin; for each row of the slab polygon's y
+// range, clip again to the widened row; the row polygon's widened x extent gives the cells. The widened
+// slabs and rows contain every cell box grown by inflate_for_insertion (whose growth is at most half the
+// margin), so every cell the exact test against such a box accepts is found.
+void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, float margin, std::vector<uint64_t>& out) {
+  const CellRange r(g, t.bounds(), margin);
+  if (r.is_line()) return append_range(g, r, id, out);  // connected: it meets every cell of a line
+  SlabPolygon tri;
+  tri.v[0] = t.v0, tri.v[1] = t.v1, tri.v[2] = t.v2, tri.n = 3;
+  SlabPolygon slab, row;
+  for (int z = r.lo[2]; z <= r.hi[2]; ++z) {
+    if (r.lo[2] == r.hi[2]) slab = tri;
+    else clip_to_slab(tri, 2, g.plane(2, z) - margin, g.plane(2, z + 1) + margin, slab);
+    if (slab.n == 0) continue;
+    float lo, hi;
+    polygon_extent(slab, 1, lo, hi);
+    const int y0 = std::max(r.lo[1], g.cell_of(1, lo - margin)), y1 = std::min(r.hi[1], g.cell_of(1, hi + margin));
+    for (int y = y0; y <= y1; ++y) {
+      if (y0 == y1) row = slab;
+      else clip_to_slab(slab, 1, g.plane(1, y) - margin, g.plane(1, y + 1) + margin, row);
+      if (row.n == 0) continue;
+      polygon_extent(row, 0, lo, hi);
+      const int x0 = std::max(r.lo[0], g.cell_of(0, lo - margin)), x1 = std::min(r.hi[0], g.cell_of(0, hi + margin));
+      for (int x = x0; x <= x1; ++x) out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
+    }
+  }
 }
 
 }  // namespace
 
-GridCells build_grid_cells(const GridLayout& g, std::span<const AABB> prim_bounds, const OverlapTest& overlaps) {
+CellInserter box_test_inserter(const GridLayout& g, std::span<const AABB> prim_bounds, OverlapTest overlaps) {
+  const float margin = insertion_margin(g);
+  return [&g, prim_bounds, overlaps = std::move(overlaps), margin](uint32_t id, std::vector<uint64_t>& out) {
+    if (prim_bounds[id].empty()) return;
+    const CellRange r(g, prim_bounds[id], margin);
+    // A range one cell thick on two axes needs no test: the primitive is connected, so it meets every
+    // slab its bounds span (a cell added only because of the margin is harmless, one more reference).
+    if (r.is_line()) return append_range(g, r, id, out);
+    for (int z = r.lo[2]; z <= r.hi[2]; ++z)
+      for (int y = r.lo[1]; y <= r.hi[1]; ++y)
+        for (int x = r.lo[0]; x <= r.hi[0]; ++x)
+          if (overlaps(id, inflate_for_insertion(g.cell_box(x, y, z)))) out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
+  };
+}
+
+CellInserter triangle_inserter(const GridLayout& g, std::span<const Triangle> triangles) {
+  const float margin = insertion_margin(g);
+  return [&g, triangles, margin](uint32_t id, std::vector<uint64_t>& out) { voxelize_triangle(g, triangles[id], id, margin, out); };
+}
+
+GridCells build_grid_cells(const GridLayout& g, size_t n, const CellInserter& insert) {
   GridCells cells;
-  const size_t n = prim_bounds.size(), blocks = (n + kBlock - 1) / kBlock;
+  const size_t blocks = (n + kBlock - 1) / kBlock;
   cells.offsets.assign(g.cells() + 1, 0);
   std::vector<std::vector<uint64_t>> pairs(blocks);
-  const float margin = insertion_margin(g);
   // Pass 1: the (cell, id) pairs of each block, and the per-cell counts.
   tbb::parallel_for(size_t(0), blocks, [&](size_t blk) {
     const size_t begin = blk * kBlock, end = std::min(n, begin + kBlock);
-    for (size_t i = begin; i < end; ++i)
-      if (!prim_bounds[i].empty()) insert_primitive(g, uint32_t(i), prim_bounds[i], margin, overlaps, pairs[blk]);
+    for (size_t i = begin; i < end; ++i) insert(uint32_t(i), pairs[blk]);
     for (uint64_t p : pairs[blk]) std::atomic_ref<uint32_t>(cells.offsets[(p >> 32) + 1]).fetch_add(1, std::memory_order_relaxed);
   });
   for (size_t c = 1; c < cells.offsets.size(); ++c) cells.offsets[c] += cells.offsets[c - 1];

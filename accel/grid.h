@@ -65,12 +65,30 @@ struct GridCells {
   std::vector<uint32_t> ids;
 };
 
+/// Appends to `out` the cells primitive `id` goes into, each as (cell index << 32) | id, in ascending
+/// cell order.
+using CellInserter = std::function<void(uint32_t id, std::vector<uint64_t>& out)>;
+
 /// Exact overlap of primitive i with a box (the primitive set's overlaps()).
 using OverlapTest = std::function<bool(uint32_t, const AABB&)>;
 
-/// Two-pass insertion (count, then fill) on TBB: primitive i goes into every cell whose inflated box
-/// (inflate_for_insertion) it overlaps. Deterministic for any thread count.
-GridCells build_grid_cells(const GridLayout& layout, std::span<const AABB> prim_bounds, const OverlapTest& overlaps);
+/// Generic insertion (any primitive set): every cell of the primitive's margin-widened bounds whose
+/// inflated box (inflate_for_insertion) the primitive overlaps according to `overlaps`.
+CellInserter box_test_inserter(const GridLayout& layout, std::span<const AABB> prim_bounds, OverlapTest overlaps);
+
+/// Triangle insertion by voxelization: the triangle is clipped to each slab of cells along z, the slab
+/// polygon to each row along y, and the row polygon's x extent gives the cells. Every slab, row and extent
+/// is widened by insertion_margin(), which covers every cell's inflate_for_insertion, so no cell the
+/// generic test would accept is lost.
+CellInserter triangle_inserter(const GridLayout& layout, std::span<const Triangle> triangles);
+
+/// Margin covering the inflation of every cell box of the grid (inflate_for_insertion grows a box by 2^-18
+/// of the largest of its extent and coordinates; this is twice that for the whole grid box).
+float insertion_margin(const GridLayout& layout);
+
+/// Two-pass insertion of primitives [0, n) (collect the (cell, id) pairs per block of primitives on TBB,
+/// then count and fill): deterministic for any thread count, the ids of every cell ascending.
+GridCells build_grid_cells(const GridLayout& layout, size_t n, const CellInserter& insert);
 
 /// A small direct-mapped per-ray mailbox (Amanatides and Woo 1987, section 4): remembers recently tested
 /// ids so a primitive spanning several cells is tested once. It lives on the tracing thread's stack, so it
@@ -170,18 +188,18 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   void do_build() override {
     const size_t n = prims_->size();
     layout_ = make_grid_layout(prims_->bounds(), n, config_);
-    std::vector<AABB> boxes(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) boxes[i] = prims_->bounds(i);
-    });
-    const P& prims = *prims_;
-    cells_ = build_grid_cells(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
-      if constexpr (std::is_same_v<P, TrianglePrims>) {  // fast exact accept: a vertex inside the box
-        const Triangle& t = prims.triangle(i);
-        if (b.contains(t.v0) || b.contains(t.v1) || b.contains(t.v2)) return true;
-      }
-      return prims.overlaps(i, b);
-    });
+    if constexpr (std::is_same_v<P, TrianglePrims>) {
+      cells_ = build_grid_cells(layout_, n, triangle_inserter(layout_, prims_->triangles()));
+    } else {
+      std::vector<AABB> boxes(n);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) boxes[i] = prims_->bounds(i);
+      });
+      const P& prims = *prims_;
+      cells_ = build_grid_cells(layout_, n, box_test_inserter(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
+                                  return prims.overlaps(i, b);
+                                }));
+    }
     fill_stats();
   }
 

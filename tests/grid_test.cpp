@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace ab {
 namespace {
 
@@ -83,6 +85,43 @@ TEST(Grid, ExactInsertionBeatsBoundsInsertion) {
   EXPECT_GT(cells, 100u);
   EXPECT_LT(grid.stats().references, cells / 4);
   EXPECT_EQ(count_differences("grid", m, adversarial_rays(m, 500, 8), {{"lambda", "8"}}), 0u);
+}
+
+/// Cells of mesh at density lambda from the voxelizer and from the generic exact test per cell.
+std::pair<GridCells, GridCells> both_insertions(const Mesh& mesh, double lambda) {
+  const TrianglePrims prims(std::make_shared<const Mesh>(mesh));
+  GridConfig config;
+  config.lambda = lambda;
+  const GridLayout layout = make_grid_layout(prims.bounds(), prims.size(), config);
+  std::vector<AABB> boxes;
+  for (size_t i = 0; i < prims.size(); ++i) boxes.push_back(prims.bounds(i));
+  GridCells voxelized = build_grid_cells(layout, prims.size(), triangle_inserter(layout, prims.triangles()));
+  GridCells tested = build_grid_cells(layout, prims.size(), box_test_inserter(layout, boxes, [&](uint32_t i, const AABB& b) {
+                                        return prims.overlaps(i, b);
+                                      }));
+  return {std::move(voxelized), std::move(tested)};
+}
+
+TEST(Grid, VoxelizationKeepsEveryCellOfTheExactTest) {
+  Mesh diagonal;  // long thin triangles across many cells, one lying in a cell plane
+  diagonal.vertices = {{0, 0, 0}, {1, 1, 1}, {1.0f, 1.0f, 0.98f}, {0, 0, 1}, {0.01f, 0, 1}, {0, 0.01f, 1},
+                       {0, 0.5f, 0}, {1, 0.5f, 0}, {1, 0.5f, 1}};
+  diagonal.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
+  const Mesh meshes[] = {random_soup(3000, 41, 0.1f), random_soup(500, 42, 0.6f), adversarial_mesh(12), diagonal};
+  for (const Mesh& mesh : meshes) {
+    for (double lambda : {0.5, 2.0, 5.0}) {
+      const auto [voxelized, tested] = both_insertions(mesh, lambda);
+      size_t lost = 0;
+      for (size_t c = 0; c + 1 < tested.offsets.size(); ++c) {
+        const auto t0 = tested.ids.begin() + tested.offsets[c], t1 = tested.ids.begin() + tested.offsets[c + 1];
+        const auto v0 = voxelized.ids.begin() + voxelized.offsets[c], v1 = voxelized.ids.begin() + voxelized.offsets[c + 1];
+        lost += !std::includes(v0, v1, t0, t1);
+      }
+      EXPECT_EQ(lost, 0u) << "lambda " << lambda;
+      EXPECT_GE(voxelized.ids.size(), tested.ids.size());
+      EXPECT_LE(voxelized.ids.size(), tested.ids.size() * 103 / 100 + 8) << "lambda " << lambda;  // only the margin's extra
+    }
+  }
 }
 
 TEST(Grid, CellsAreDeterministicAndSorted) {
