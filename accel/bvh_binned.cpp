@@ -48,12 +48,13 @@ struct alignas(16) Box4 {
     hi = _mm_max_ps(hi, h);
   }
   void extend(const Box4& b) { extend(b.lo, b.hi); }
-  /// The same value as AABB::area() of the same box (0 when empty).
+  /// The same value as AABB::area() of the same box, 2 (dx dy + dy dz + dz dx) with the same rounding, and
+  /// 0 when empty (the extent is clamped at 0 instead of branching).
   float area() const {
-    alignas(16) float d[4];
-    _mm_store_ps(d, _mm_sub_ps(hi, lo));
-    if (d[0] < 0.0f || d[1] < 0.0f || d[2] < 0.0f) return 0.0f;
-    return 2.0f * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+    const __m128 d = _mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps());
+    const __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));  // dx dy, dy dz, dz dx
+    const __m128 s = _mm_add_ss(_mm_add_ss(p, _mm_shuffle_ps(p, p, 1)), _mm_shuffle_ps(p, p, 2));
+    return 2.0f * _mm_cvtss_f32(s);
   }
   AABB aabb() const {
     alignas(16) float l[4], h[4];
@@ -109,6 +110,71 @@ struct BinSet {
     for (int k = 0; k < 3 * nb; ++k) box[k].extend(o.box[k]), count[k] += o.count[k];
   }
 };
+
+/// Areas of three boxes at once (lane a: box a), each bit for bit AABB::area() (same products, same order).
+__m128 areas3(const Box4* box) {
+  __m128 x = _mm_max_ps(_mm_sub_ps(box[0].hi, box[0].lo), _mm_setzero_ps());
+  __m128 y = _mm_max_ps(_mm_sub_ps(box[1].hi, box[1].lo), _mm_setzero_ps());
+  __m128 z = _mm_max_ps(_mm_sub_ps(box[2].hi, box[2].lo), _mm_setzero_ps());
+  __m128 w = _mm_setzero_ps();
+  _MM_TRANSPOSE4_PS(x, y, z, w);  // now x, y, z hold the extents along x, y, z of the three boxes
+  const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+  return _mm_mul_ps(_mm_set1_ps(2.0f), s);
+}
+
+/// best_bin_split (sah.h) for the three axes at once, one per vector lane: the same suffix areas, the same
+/// weighted areas left_area * left_count + right_area * right_count and the same choice (the first
+/// cheapest boundary per axis, then the first cheapest axis), so the tree is the one the scalar form gives.
+/// Axes whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
+SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_area, const SahCosts& costs) {
+  const int n = bins.nb;
+  auto counts = [&](int k) { return _mm_setr_epi32(int(bins.count[k]), int(bins.count[n + k]), int(bins.count[2 * n + k]), 0); };
+  auto extend = [&](Box4* acc, int k) {
+    for (int a = 0; a < 3; ++a) acc[a].extend(bins.box[a * n + k]);
+  };
+  __m128 right_area[kMaxBins];  // only [1, n) is written and read
+  __m128i right_count[kMaxBins];
+  Box4 acc[3] = {Box4::empty(), Box4::empty(), Box4::empty()};
+  __m128i cnt = _mm_setzero_si128();
+  for (int i = n - 1; i > 0; --i) {
+    extend(acc, i);
+    cnt = _mm_add_epi32(cnt, counts(i));
+    right_area[i] = areas3(acc);
+    right_count[i] = cnt;
+  }
+  acc[0] = acc[1] = acc[2] = Box4::empty();
+  cnt = _mm_setzero_si128();
+  __m128 best_w = _mm_set1_ps(kInf), best_la = _mm_setzero_ps(), best_ra = _mm_setzero_ps();
+  __m128i best_i = _mm_setzero_si128(), best_lc = _mm_setzero_si128();
+  for (int i = 1; i < n; ++i) {
+    extend(acc, i - 1);
+    cnt = _mm_add_epi32(cnt, counts(i - 1));
+    const __m128 la = areas3(acc), ra = right_area[i];
+    const __m128 w = _mm_add_ps(_mm_mul_ps(la, _mm_cvtepi32_ps(cnt)), _mm_mul_ps(ra, _mm_cvtepi32_ps(right_count[i])));
+    const __m128i empty_side = _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()),
+                                            _mm_cmpeq_epi32(right_count[i], _mm_setzero_si128()));
+    const __m128 better = _mm_andnot_ps(_mm_castsi128_ps(empty_side), _mm_and_ps(axis_ok, _mm_cmplt_ps(w, best_w)));
+    best_w = _mm_blendv_ps(best_w, w, better);
+    best_la = _mm_blendv_ps(best_la, la, better);
+    best_ra = _mm_blendv_ps(best_ra, ra, better);
+    best_i = _mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(best_i), _mm_castsi128_ps(_mm_set1_epi32(i)), better));
+    best_lc = _mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(best_lc), _mm_castsi128_ps(cnt), better));
+  }
+  alignas(16) int32_t bi[4], lc[4], total[4];
+  alignas(16) float bla[4], bra[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(bi), best_i);
+  _mm_store_si128(reinterpret_cast<__m128i*>(lc), best_lc);
+  _mm_store_si128(reinterpret_cast<__m128i*>(total), _mm_add_epi32(cnt, counts(n - 1)));
+  _mm_store_ps(bla, best_la);
+  _mm_store_ps(bra, best_ra);
+  SahSplit best;
+  for (int a = 0; a < 3; ++a) {
+    if (bi[a] == 0) continue;
+    const float c = costs.split(parent_area, bla[a], uint32_t(lc[a]), bra[a], uint32_t(total[a] - lc[a]));
+    if (c < best.cost) best = {a, bi[a], c};
+  }
+  return best;
+}
 
 /// TBB body binning a large range in parallel (the imperative form: a BinSet is copied only when a
 /// subrange is stolen).
@@ -236,15 +302,8 @@ BinnedSplit BinnedBuilder::find_split(uint32_t b, uint32_t e, const NodeBounds& 
   const BinIndexer ix(map);
   BinnedSplit out;
   auto evaluate = [&](const BinSet& bins) {
-    const float area = nb.box.area();
-    for (int a = 0; a < 3; ++a)
-      if (map.scale[a] > 0.0f) {
-        const Box4* box = &bins.box[a * bins.nb];
-        const uint32_t* count = &bins.count[a * bins.nb];
-        best_bin_split_of(
-            bins.nb, a, area, config_.costs, out.sah, Box4::empty(), [&](int k) -> const Box4& { return box[k]; },
-            [&](int k) { return count[k]; });
-      }
+    const __m128 axis_ok = _mm_cmpgt_ps(_mm_setr_ps(map.scale[0], map.scale[1], map.scale[2], 0.0f), _mm_setzero_ps());
+    out.sah = best_split_three_axes(bins, axis_ok, nb.box.area(), config_.costs);
     if (out.sah.axis < 0) return;
     const int base = out.sah.axis * bins.nb;
     for (int k = 0; k < bins.nb; ++k) {
