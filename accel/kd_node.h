@@ -3,6 +3,7 @@
 // insertion helpers shared by the k-d builders.
 #pragma once
 
+#include "accel/error.h"
 #include "accel/geometry.h"
 #include "accel/primitives.h"
 #include "accel/stats.h"
@@ -17,15 +18,19 @@
 
 namespace ab {
 
-/// One k-d tree node: an interior node (axis, split coordinate, index of the above child; the below
-/// child follows it directly) or a leaf (offset and count of its primitive indices).
+/// One k-d tree node: an interior node (axis, split coordinate, index of the above child, and a flag per
+/// child that is an empty leaf; the below child, when not empty, follows it directly) or a leaf (offset and
+/// count of its primitive indices). Empty children are flags rather than nodes (drop_empty_leaves), so the
+/// traversal never visits or stacks them.
 class KdNode {
  public:
   /// A leaf of `count` primitive indices starting at `first`.
   static KdNode leaf(uint32_t first, uint32_t count) { return KdNode(first, (count << 2) | 3u); }
-  /// An interior node splitting `axis` at `split`; the above child is node `above`.
-  static KdNode interior(int axis, float split, uint32_t above) {
-    return KdNode(std::bit_cast<uint32_t>(split), (above << 2) | uint32_t(axis));
+  /// An interior node splitting `axis` at `split`; the above child is node `above`; a child flagged
+  /// empty has no node.
+  static KdNode interior(int axis, float split, uint32_t above, bool below_empty = false, bool above_empty = false) {
+    return KdNode(std::bit_cast<uint32_t>(split),
+                  (above << 4) | (uint32_t(above_empty) << 3) | (uint32_t(below_empty) << 2) | uint32_t(axis));
   }
 
   /// True for a leaf.
@@ -35,7 +40,11 @@ class KdNode {
   /// Split coordinate (interior nodes).
   float split() const { return std::bit_cast<float>(word_); }
   /// Index of the above child (interior nodes); the below child is this node's index + 1.
-  uint32_t above() const { return bits_ >> 2; }
+  uint32_t above() const { return bits_ >> 4; }
+  /// True when the below child is an empty leaf (interior nodes).
+  bool below_empty() const { return (bits_ & 4u) != 0; }
+  /// True when the above child is an empty leaf (interior nodes).
+  bool above_empty() const { return (bits_ & 8u) != 0; }
   /// First primitive index (leaves).
   uint32_t first() const { return word_; }
   /// Number of primitives (leaves).
@@ -45,7 +54,7 @@ class KdNode {
     if (is_leaf()) {
       word_ += prim_base;
     } else {
-      bits_ += node_base << 2;
+      bits_ += node_base << 4;
     }
   }
 
@@ -56,8 +65,8 @@ class KdNode {
 };
 static_assert(sizeof(KdNode) == 8);
 
-/// Largest node index or primitive count a KdNode can hold.
-inline constexpr uint32_t kKdMaxIndex = (1u << 30) - 1;
+/// Largest node index an interior KdNode can hold.
+inline constexpr uint32_t kKdMaxIndex = (1u << 28) - 1;
 
 /// Nodes in depth-first order (below child next to its parent) and the leaves' primitive indices.
 struct KdBuffer {
@@ -80,6 +89,35 @@ struct KdBuffer {
     prims.insert(prims.end(), sub.prims.begin(), sub.prims.end());
   }
 };
+
+/// Removes the empty leaves of a depth-first tree (all but an empty root): their parents flag them instead.
+/// Throws InputError when the remaining nodes do not fit the node's index field.
+inline void drop_empty_leaves(std::vector<KdNode>& nodes) {
+  const size_t n = nodes.size();
+  auto empty = [&](size_t i) { return i != 0 && nodes[i].is_leaf() && nodes[i].count() == 0; };
+  std::vector<uint32_t> remap(n);
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    remap[i] = uint32_t(kept);
+    kept += !empty(i);
+  }
+  if (kept > kKdMaxIndex) throw InputError("k-d tree: more than 2^28 nodes (mesh too large for this structure)");
+  std::vector<KdNode> out;
+  out.reserve(kept);
+  for (size_t i = 0; i < n; ++i) {
+    const KdNode& nd = nodes[i];
+    if (empty(i)) continue;
+    if (nd.is_leaf()) {
+      out.push_back(nd);
+      continue;
+    }
+    const bool below_empty = empty(i + 1);
+    const bool above_empty = empty(nd.above()) && !below_empty;  // a split always keeps one side
+    out.push_back(KdNode::interior(nd.axis(), nd.split(), above_empty ? 0 : remap[nd.above()], below_empty,
+                                   above_empty));
+  }
+  nodes.swap(out);
+}
 
 /// Margin of conservative insertion for a node box: a primitive within it of a split plane goes to both
 /// children. Same scale as inflate_for_insertion (clip.h): relative to the box's size and position.

@@ -45,7 +45,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
 
   /// Closest hit: front-to-back traversal with a stack of far children.
   template <bool kCount>
-  void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
     if (!unbounded_.empty())
       intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
     traverse<kCount>(
@@ -87,6 +87,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
         KdMedianBuilder<P>(*prims_, s).build(ids, box_, out);
       }
     }
+    drop_empty_leaves(out.nodes);
     nodes_ = std::move(out.nodes);
     leaves_.assign(*prims_, std::move(out.prims));
     fill_stats(depth);
@@ -120,14 +121,19 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
         const uint32_t below = idx + 1, above = n.above();
         const uint32_t first = x.below_first ? below : above;
         const uint32_t second = x.below_first ? above : below;
-        if (x.near > t1) {
-          idx = first;
-        } else if (x.far < t0) {
-          idx = second;
-        } else {
-          stack[sp++] = {second, std::max(t0, x.near), t1};
+        const bool first_empty = x.below_first ? n.below_empty() : n.above_empty();
+        const bool second_empty = x.below_first ? n.above_empty() : n.below_empty();
+        const bool visit_first = !(x.far < t0) && !first_empty;
+        const bool visit_second = !(x.near > t1) && !second_empty;
+        if (visit_first) {
+          if (visit_second) stack[sp++] = {second, std::max(t0, x.near), t1};
           t1 = std::min(t1, x.far);
           idx = first;
+        } else if (visit_second) {
+          t0 = std::max(t0, x.near);
+          idx = second;
+        } else {
+          goto pop;  // only an empty child lies in the interval
         }
         n = nodes[idx];
       }
@@ -136,6 +142,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
         ++c.leaves;
       }
       if (n.count() && leaf(n.first(), n.count())) return true;
+    pop:
       const float limit = best_t();
       do {
         if (sp == 0) return false;
@@ -176,9 +183,13 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       AABB lo = it.box, hi = it.box;
       lo.hi[n.axis()] = n.split();
       hi.lo[n.axis()] = n.split();
-      todo.push_back({n.above(), it.depth + 1, hi});
-      todo.push_back({it.node + 1, it.depth + 1, lo});
+      if (n.above_empty()) st.add_leaf(0, it.depth + 1);
+      else todo.push_back({n.above(), it.depth + 1, hi});
+      if (n.below_empty()) st.add_leaf(0, it.depth + 1);
+      else todo.push_back({it.node + 1, it.depth + 1, lo});
     }
+    st.extra["stored_nodes"] = nodes_.size();  // nodes: also the empty leaves, which are flags, not nodes
+    st.nodes = 2 * st.leaves - 1;
     st.sah_cost = sah;
   }
 

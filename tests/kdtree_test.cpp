@@ -85,6 +85,64 @@ TEST(KdNode, EncodesLeavesAndInteriorNodes) {
   EXPECT_EQ(moved.count(), 45u);
 }
 
+TEST(KdNode, FlagsEmptyChildrenAndKeepsThemThroughRebase) {
+  KdNode inner = KdNode::interior(1, 0.5f, (1u << 28) - 1, true, false);
+  EXPECT_FALSE(inner.is_leaf());
+  EXPECT_EQ(inner.axis(), 1);
+  EXPECT_TRUE(inner.below_empty());
+  EXPECT_FALSE(inner.above_empty());
+  EXPECT_EQ(inner.above(), (1u << 28) - 1);
+  KdNode other = KdNode::interior(0, 2.0f, 5, false, true);
+  other.rebase(3, 100);
+  EXPECT_FALSE(other.below_empty());
+  EXPECT_TRUE(other.above_empty());
+  EXPECT_EQ(other.above(), 8u);
+}
+
+TEST(KdNode, DropEmptyLeavesFlagsThemInTheParents) {
+  // Depth-first: 0 splits x (below 1, above 4); 1 splits y (below 2: empty, above 3: leaf);
+  // 4 splits z (below 5: leaf, above 6: empty).
+  std::vector<KdNode> nodes{KdNode::interior(0, 0.0f, 4), KdNode::interior(1, 1.0f, 3), KdNode::leaf(0, 0),
+                            KdNode::leaf(0, 2),           KdNode::interior(2, 2.0f, 6), KdNode::leaf(2, 1),
+                            KdNode::leaf(0, 0)};
+  drop_empty_leaves(nodes);
+  ASSERT_EQ(nodes.size(), 5u);
+  EXPECT_FALSE(nodes[0].below_empty() || nodes[0].above_empty());
+  EXPECT_EQ(nodes[0].above(), 3u);
+  EXPECT_TRUE(nodes[1].below_empty());
+  EXPECT_FALSE(nodes[1].above_empty());
+  EXPECT_EQ(nodes[1].above(), 2u);
+  EXPECT_EQ(nodes[2].count(), 2u);
+  EXPECT_EQ(nodes[3].axis(), 2);
+  EXPECT_TRUE(nodes[3].above_empty());
+  EXPECT_EQ(nodes[4].count(), 1u);
+  EXPECT_EQ(nodes[4].first(), 2u);
+  // An empty root stays.
+  std::vector<KdNode> root{KdNode::leaf(0, 0)};
+  drop_empty_leaves(root);
+  EXPECT_EQ(root.size(), 1u);
+}
+
+TEST(SplitPlane, AxisRayCrossingsAreWidenedAndZeroDirectionsNeedNoBranch) {
+  Ray ray;
+  ray.org = {0.0f, 1.0f, 2.0f};
+  ray.dir = {0.5f, 0.0f, -0.0f};
+  const AxisRay r(ray);
+  const AxisCrossing x = r.cross(0, 1.0f);  // crossing at t = 2, below side first
+  EXPECT_TRUE(x.below_first);
+  EXPECT_LT(x.near, 2.0f);
+  EXPECT_GT(x.far, 2.0f);
+  const AxisCrossing above = r.cross(1, 0.5f);  // parallel, origin above: never reaches the below side
+  EXPECT_TRUE(above.below_first);
+  EXPECT_TRUE(above.far < 0.0f);  // -inf: the first (below) side is skipped
+  const AxisCrossing behind = r.cross(2, 3.0f);  // -0 direction: above first; origin below the plane
+  EXPECT_FALSE(behind.below_first);
+  EXPECT_TRUE(behind.far < 0.0f);  // the above side is never reached
+  const AxisCrossing in_plane = r.cross(1, 1.0f);  // origin in the plane: NaN, both sides visited
+  EXPECT_FALSE(in_plane.near > 10.0f);
+  EXPECT_FALSE(in_plane.far < 0.0f);
+}
+
 TEST(SplitPlane, ParallelRaysStayOnTheirSideAndInPlaneRaysSeeBoth) {
   const PlaneVisit below = split_at_axis_plane(0.0f, 0.0f, kInf, 1.0f, 0.0f, 10.0f);
   EXPECT_TRUE(below.first_below);
@@ -184,7 +242,10 @@ TEST(KdTree, StatisticsDescribeABinaryTree) {
     }
     EXPECT_EQ(refs, s.references);
     EXPECT_EQ(leaves, s.leaves);
-    EXPECT_EQ(s.bytes, s.nodes * 8 + s.references * (4 + sizeof(Triangle)));  // ids and leaf-order copies
+    // Stored nodes (empty leaves are flags in their parents), ids and leaf-order triangle copies.
+    const uint64_t stored = s.extra.at("stored_nodes").get<uint64_t>();
+    EXPECT_EQ(stored, s.nodes - s.empty_leaves) << name;
+    EXPECT_EQ(s.bytes, stored * 8 + s.references * (4 + sizeof(Triangle))) << name;
     EXPECT_LE(s.max_depth, uint32_t(auto_kd_depth(3000)));
   }
   EXPECT_LE(built("kdtree-median", mesh, {{"max_depth", "5"}})->stats().max_depth, 5u);
