@@ -120,12 +120,12 @@ BvhBuildResult flatten_bvh_slots(const BvhSlots& slots, std::vector<uint32_t> or
   BvhBuildResult out;
   out.stats.primitives = order.size();
   out.order = std::move(order);
-  if (slots.slots.empty()) return out;
+  if (slots.size == 0) return out;
   struct Item {
     uint32_t slot, index, depth;
   };
-  const std::vector<BvhNode>& in = slots.slots;
-  out.nodes.reserve(in.size() + 1);
+  const BvhNode* in = slots.slots.get();
+  out.nodes.reserve(slots.size + 1);
   out.nodes.resize(2);
   out.nodes[1] = BvhNode{{kInf, kInf, kInf}, 0, {-kInf, -kInf, -kInf}, 1};  // padding, never visited
   std::vector<Item> stack{{0, 0, 0}};

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <memory>
 
 namespace ab {
 
@@ -200,7 +201,9 @@ struct BinnedSplit {
 // centroids are projected into equal-width bins on all three axes in one pass (SSE: one vector of bin
 // indices and one box update per axis), every bin boundary is evaluated by a sweep over the bins, and the
 // range is partitioned at the cheapest one. The partition pass also computes the children's
-// centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. Nodes
+// centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. The
+// partition moves references between two buffers (a node's children live in the other buffer than the
+// node; a leaf left in the second buffer is copied back), so nothing is copied back per node. Nodes
 // above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
 // parallel; the tree is the same for any number of threads.
 class BinnedBuilder {
@@ -211,48 +214,56 @@ class BinnedBuilder {
   BvhBuildResult run();
 
  private:
-  void build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth);
-  BinnedSplit find_split(uint32_t b, uint32_t e, const NodeBounds& nb, const BinMapping& map) const;
-  void partition(uint32_t b, uint32_t m, uint32_t e, int axis, int position, const BinMapping& map, Box4& left_c,
-                 Box4& right_c);
+  void build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer);
+  void make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer);
+  BinnedSplit find_split(const BinRef* refs, uint32_t b, uint32_t e, const NodeBounds& nb, const BinMapping& map) const;
+  void partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis, int position,
+                 const BinMapping& map, Box4& left_c, Box4& right_c);
   NodeBounds root_bounds() const;
 
   const BvhConfig& config_;
-  std::vector<BinRef> refs_;
-  std::vector<BinRef> scratch_;  ///< partition buffer (ranges of parallel nodes are disjoint)
+  size_t n_;
+  /// The references (buffer 0, which holds the final leaf order) and the second partition buffer;
+  /// uninitialized allocations (every element is written before it is read).
+  std::unique_ptr<BinRef[]> buffers_[2];
   BvhSlots slots_;
 };
 
 BinnedBuilder::BinnedBuilder(const BvhConfig& config, std::span<const AABB> bounds)
-    : config_(config), refs_(bounds.size()), scratch_(bounds.size()), slots_(bounds.size()) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, refs_.size(), kGrain), [&](const tbb::blocked_range<size_t>& r) {
+    : config_(config), n_(bounds.size()), buffers_{std::make_unique_for_overwrite<BinRef[]>(n_),
+                                                  std::make_unique_for_overwrite<BinRef[]>(n_)},
+      slots_(n_) {
+  BinRef* refs = buffers_[0].get();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const AABB& b = bounds[i];
-      refs_[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+      refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
     }
   });
 }
 
 BvhBuildResult BinnedBuilder::run() {
-  const size_t n = refs_.size();
-  if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0);
+  const size_t n = n_;
+  if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0, 0);
   std::vector<uint32_t> order(n);
+  const BinRef* refs = buffers_[0].get();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs_[k].id;
+    for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs[k].id;
   });
   return flatten_bvh_slots(slots_, std::move(order));
 }
 
 NodeBounds BinnedBuilder::root_bounds() const {
+  const BinRef* refs = buffers_[0].get();
   auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
     for (size_t k = r.begin(); k < r.end(); ++k) {
-      acc.box.extend(refs_[k].lo4(), refs_[k].hi4());
-      const __m128 c = refs_[k].center();
+      acc.box.extend(refs[k].lo4(), refs[k].hi4());
+      const __m128 c = refs[k].center();
       acc.centroids.extend(c, c);
     }
     return acc;
   };
-  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, refs_.size(), kGrain), NodeBounds{}, body,
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, n_, kGrain), NodeBounds{}, body,
                               [](NodeBounds x, const NodeBounds& y) {
                                 x.box.extend(y.box);
                                 x.centroids.extend(y.centroids);
@@ -260,35 +271,46 @@ NodeBounds BinnedBuilder::root_bounds() const {
                               });
 }
 
-void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth) {
+/// A leaf over [b, e); its references are moved to buffer 0 if they are in buffer 1.
+void BinnedBuilder::make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer) {
+  slots_.set_leaf(p, b, e);
+  if (buffer == 1) std::copy(buffers_[1].get() + b, buffers_[1].get() + e, buffers_[0].get() + b);
+}
+
+/// Builds the subtree of slot p over [b, e) of buffers_[buffer].
+void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer) {
   const AABB box = nb.box.aabb();
   slots_.set_box(p, box);
   const uint32_t n = e - b;
-  if (depth >= config_.max_depth || n == 1) return slots_.set_leaf(p, b, e);
+  if (depth >= config_.max_depth || n == 1) return make_leaf(p, b, e, buffer);
+  const BinRef* refs = buffers_[buffer].get();
   // Small nodes use as many bins as primitives (at least 4): more could not separate them better on
   // average, and evaluating unused boundaries would dominate the cost near the leaves.
   const BinMapping map(nb.centroids.aabb(), std::min(config_.bins, std::max(4, int(n))));
-  const BinnedSplit split = find_split(b, e, nb, map);
+  const BinnedSplit split = find_split(refs, b, e, nb, map);
   const uint32_t decision = sah_decision(n, split.sah, config_);
-  if (decision == 0) return slots_.set_leaf(p, b, e);
+  if (decision == 0) return make_leaf(p, b, e, buffer);
   NodeBounds left, right;
   uint32_t m;
+  int child_buffer = buffer;
   if (decision == n) {
     left.box = split.left;
     right.box = split.right;
     m = b + split.left_count;
-    partition(b, m, e, split.sah.axis, split.sah.position, map, left.centroids, right.centroids);
+    child_buffer = 1 - buffer;
+    partition(refs, buffers_[child_buffer].get(), b, m, e, split.sah.axis, split.sah.position, map, left.centroids,
+              right.centroids);
   } else {  // forced split in the middle of the current order
     m = b + decision;
     for (uint32_t k = b; k < e; ++k) {
       NodeBounds& side = k < m ? left : right;
-      side.box.extend(refs_[k].lo4(), refs_[k].hi4());
-      side.centroids.extend(refs_[k].center(), refs_[k].center());
+      side.box.extend(refs[k].lo4(), refs[k].hi4());
+      side.centroids.extend(refs[k].center(), refs[k].center());
     }
   }
   const uint32_t right_slot = slots_.set_interior(p, b, m);
-  auto build_left = [&] { build(p + 1, b, m, left, depth + 1); };
-  auto build_right = [&] { build(right_slot, m, e, right, depth + 1); };
+  auto build_left = [&] { build(p + 1, b, m, left, depth + 1, child_buffer); };
+  auto build_right = [&] { build(right_slot, m, e, right, depth + 1, child_buffer); };
   if (n >= config_.parallel_threshold) {
     tbb::parallel_invoke(build_left, build_right);
   } else {
@@ -298,7 +320,8 @@ void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& 
 }
 
 /// Bins the node with `map` and finds the cheapest bin boundary over the three axes.
-BinnedSplit BinnedBuilder::find_split(uint32_t b, uint32_t e, const NodeBounds& nb, const BinMapping& map) const {
+BinnedSplit BinnedBuilder::find_split(const BinRef* refs, uint32_t b, uint32_t e, const NodeBounds& nb,
+                                      const BinMapping& map) const {
   const BinIndexer ix(map);
   BinnedSplit out;
   auto evaluate = [&](const BinSet& bins) {
@@ -313,10 +336,10 @@ BinnedSplit BinnedBuilder::find_split(uint32_t b, uint32_t e, const NodeBounds& 
   };
   if (e - b < kParallelReduceThreshold) {
     BinSet bins(map.bins);
-    bins.add(refs_.data(), b, e, ix);
+    bins.add(refs, b, e, ix);
     evaluate(bins);
   } else {
-    ParallelBinning body(refs_.data(), ix, map.bins);
+    ParallelBinning body(refs, ix, map.bins);
     tbb::parallel_reduce(tbb::blocked_range<uint32_t>(b, e, kGrain), body);
     evaluate(body.bins);
   }
@@ -324,13 +347,11 @@ BinnedSplit BinnedBuilder::find_split(uint32_t b, uint32_t e, const NodeBounds& 
 }
 
 /// Partitions [b, e) stably into [b, m), the primitives whose bin on `axis` lies below `position` (m - b
-/// of them, known from the bins), and [m, e), gathering each side's centroid bounds. Branch-free: each
-/// reference is written to the scratch buffer at the cursor of its side (a conditional move, not a
-/// mispredicted branch), then the range is copied back.
-void BinnedBuilder::partition(uint32_t b, uint32_t m, uint32_t e, int axis, int position, const BinMapping& map,
-                              Box4& left_c, Box4& right_c) {
-  const BinRef* refs = refs_.data();
-  BinRef* out = scratch_.data();
+/// of them, known from the bins), and [m, e), from refs into out, gathering each side's centroid bounds.
+/// Branch-free: each reference is written at the cursor of its side (a conditional move, not a
+/// mispredicted branch).
+void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis,
+                              int position, const BinMapping& map, Box4& left_c, Box4& right_c) {
   const float lo = map.lo[axis], scale = map.scale[axis];
   const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
   uint32_t l = b, r = m;
@@ -345,7 +366,6 @@ void BinnedBuilder::partition(uint32_t b, uint32_t m, uint32_t e, int axis, int 
     left_c.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
     right_c.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
   }
-  std::copy(out + b, out + e, refs_.data() + b);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "accel/bvh.h"
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -16,10 +17,11 @@ namespace ab {
 /// can be built in parallel. A leaf stores offset b and count e - b; an interior node the right child's
 /// slot in offset and count 0. 2N - 1 slots hold any tree over N primitives.
 struct BvhSlots {
-  std::vector<BvhNode> slots;
+  size_t size;                       ///< 2N - 1 (0 for no primitives)
+  std::unique_ptr<BvhNode[]> slots;  ///< uninitialized: only the slots of the tree are written and read
 
   /// Room for a tree over n primitives.
-  explicit BvhSlots(size_t n) : slots(n == 0 ? 0 : 2 * n - 1) {}
+  explicit BvhSlots(size_t n) : size(n == 0 ? 0 : 2 * n - 1), slots(std::make_unique_for_overwrite<BvhNode[]>(size)) {}
   /// Writes the box of slot p.
   void set_box(uint32_t p, const AABB& box) {
     for (int a = 0; a < 3; ++a) {
