@@ -98,8 +98,14 @@ struct SlabPolygon {
   int n = 0;
 };
 
-/// Keeps the part of `in` with lo <= p[axis] <= hi (Sutherland and Hodgman 1974, two parallel planes in
-/// one pass over the edges).
+/// Range of polygon p's coordinates on an axis.
+void polygon_extent(const SlabPolygon& p, int axis, float& lo, float& hi) {
+  lo = kInf, hi = -kInf;
+  for (int i = 0; i < p.n; ++i) lo = std::min(lo, p.v[i][axis]), hi = std::max(hi, p.v[i][axis]);
+}
+
+/// Keeps the part of `in` with lo <= p[axis] <= hi (Sutherland and Hodgman 1974, against the planes that
+/// actually cut it).
 void clip_to_slab(const SlabPolygon& in, int axis, float lo, float hi, SlabPolygon& out) {
   SlabPolygon tmp;
   auto clip = [axis](const SlabPolygon& src, float plane, float sign, SlabPolygon& dst) {
@@ -113,20 +119,43 @@ void clip_to_slab(const SlabPolygon& in, int axis, float lo, float hi, SlabPolyg
         dst.v[dst.n++] = a + (da / (da - db)) * (b - a);
     }
   };
-  clip(in, hi, 1.0f, tmp);
-  clip(tmp, lo, -1.0f, out);
+  float min_c, max_c;
+  polygon_extent(in, axis, min_c, max_c);
+  if (min_c > hi || max_c < lo) {
+    out.n = 0;
+  } else if (max_c <= hi) {  // only the lower plane cuts, if any
+    if (min_c >= lo) out = in;
+    else clip(in, lo, -1.0f, out);
+  } else if (min_c >= lo) {  // only the upper plane cuts
+    clip(in, hi, 1.0f, out);
+  } else {
+    clip(in, hi, 1.0f, tmp);
+    clip(tmp, lo, -1.0f, out);
+  }
 }
 
-/// Range of polygon p's coordinates on an axis.
-void polygon_extent(const SlabPolygon& p, int axis, float& lo, float& hi) {
-  lo = kInf, hi = -kInf;
-  for (int i = 0; i < p.n; ++i) lo = std::min(lo, p.v[i][axis]), hi = std::max(hi, p.v[i][axis]);
+/// The x extent of the part of polygon p with lo <= y <= hi: the same points clipping to that row would
+/// give (the vertices inside it and the edges' crossings of its two planes), without building the polygon.
+/// Empty (lo_x > hi_x) when the polygon misses the row.
+void row_x_extent(const SlabPolygon& p, float lo, float hi, float& lo_x, float& hi_x) {
+  lo_x = kInf, hi_x = -kInf;
+  auto add = [&](float x) { lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x); };
+  for (int i = 0; i < p.n; ++i) {
+    const vec3& a = p.v[i];
+    const vec3& b = p.v[i + 1 == p.n ? 0 : i + 1];
+    if (a.y >= lo && a.y <= hi) add(a.x);
+    for (const float plane : {lo, hi}) {
+      const float da = a.y - plane, db = b.y - plane;
+      if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) add(a.x + (da / (da - db)) * (b.x - a.x));
+    }
+  }
 }
 
 // Triangle voxelization by slab and row clipping (the scan conversion of Akenine-Moller and Aila's
 // conservative voxelization, done with Sutherland-Hodgman clipping): for each z slab of the triangle's
 // cell range, clip the triangle to the slab widened by the margin; for each row of the slab polygon's y
-// range, clip again to the widened row; the row polygon's widened x extent gives the cells. The widened
+// range, the x extent of the slab polygon's part in the widened row (its clipped vertices, without building
+// the polygon), widened again, gives the cells. The widened
 // slabs and rows contain every cell box grown by inflate_for_insertion (whose growth is at most half the
 // margin), so every cell the exact test against such a box accepts is found.
 void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, float margin, std::vector<uint64_t>& out) {
@@ -134,7 +163,7 @@ void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, floa
   if (r.is_line()) return append_range(g, r, id, out);  // connected: it meets every cell of a line
   SlabPolygon tri;
   tri.v[0] = t.v0, tri.v[1] = t.v1, tri.v[2] = t.v2, tri.n = 3;
-  SlabPolygon slab, row;
+  SlabPolygon slab;
   for (int z = r.lo[2]; z <= r.hi[2]; ++z) {
     if (r.lo[2] == r.hi[2]) slab = tri;
     else clip_to_slab(tri, 2, g.plane(2, z) - margin, g.plane(2, z + 1) + margin, slab);
@@ -143,10 +172,9 @@ void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, floa
     polygon_extent(slab, 1, lo, hi);
     const int y0 = std::max(r.lo[1], g.cell_of(1, lo - margin)), y1 = std::min(r.hi[1], g.cell_of(1, hi + margin));
     for (int y = y0; y <= y1; ++y) {
-      if (y0 == y1) row = slab;
-      else clip_to_slab(slab, 1, g.plane(1, y) - margin, g.plane(1, y + 1) + margin, row);
-      if (row.n == 0) continue;
-      polygon_extent(row, 0, lo, hi);
+      if (y0 == y1) polygon_extent(slab, 0, lo, hi);
+      else row_x_extent(slab, g.plane(1, y) - margin, g.plane(1, y + 1) + margin, lo, hi);
+      if (!(lo <= hi)) continue;
       const int x0 = std::max(r.lo[0], g.cell_of(0, lo - margin)), x1 = std::min(r.hi[0], g.cell_of(0, hi + margin));
       for (int x = x0; x <= x1; ++x) out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
     }
