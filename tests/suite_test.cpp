@@ -195,7 +195,7 @@ TEST(Suite, DefaultSuiteIsTheShippedFileAndCoversTheBrief) {
 }
 
 TEST(Suite, ShippedSuitesValidate) {
-  for (const char* name : {"quick", "scaling", "default"}) {
+  for (const char* name : {"quick", "scaling", "default", "million"}) {
     const Suite s = read_suite(std::string(ACCELBENCH_SOURCE_DIR) + "/suites/" + name + ".json");
     EXPECT_NO_THROW(validate_suite(s)) << name;
   }
