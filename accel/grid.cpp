@@ -7,7 +7,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 namespace ab {
@@ -203,23 +202,76 @@ CellInserter triangle_inserter(const GridLayout& g, std::span<const Triangle> tr
   return [&g, triangles, margin](uint32_t id, std::vector<uint64_t>& out) { voxelize_triangle(g, triangles[id], id, margin, out); };
 }
 
+namespace {
+
+constexpr size_t kMaxBuckets = 256;  // cell ranges filled independently (fixed: thread-independent result)
+
+/// The (cell, id) pairs of all primitives regrouped by bucket (a contiguous range of 2^shift cells), each
+/// bucket's pairs in primitive order: a stable two-level counting sort whose scatter is parallel over blocks.
+struct BucketedPairs {
+  int shift = 0;
+  size_t buckets = 1;
+  std::vector<uint64_t> begin;  ///< bucket b's pairs are pairs[begin[b], begin[b + 1])
+  std::unique_ptr<uint64_t[]> pairs;
+
+  BucketedPairs(size_t cells, const std::vector<std::vector<uint64_t>>& blocks) {
+    while (((cells - 1) >> shift) >= kMaxBuckets) ++shift;
+    buckets = ((cells - 1) >> shift) + 1;
+    const size_t nb = blocks.size();
+    std::vector<uint64_t> start(nb * buckets, 0);  // per block and bucket: count, then write position
+    tbb::parallel_for(size_t(0), nb, [&](size_t blk) {
+      for (uint64_t p : blocks[blk]) ++start[blk * buckets + ((p >> 32) >> shift)];
+    });
+    begin.assign(buckets + 1, 0);
+    uint64_t running = 0;
+    for (size_t b = 0; b < buckets; ++b) {
+      begin[b] = running;
+      for (size_t blk = 0; blk < nb; ++blk) {  // count -> write position
+        std::swap(start[blk * buckets + b], running);
+        running += start[blk * buckets + b];
+      }
+    }
+    begin[buckets] = running;
+    pairs = std::make_unique_for_overwrite<uint64_t[]>(running);
+    tbb::parallel_for(size_t(0), nb, [&](size_t blk) {
+      uint64_t* cursor = &start[blk * buckets];
+      for (uint64_t p : blocks[blk]) pairs[cursor[(p >> 32) >> shift]++] = p;
+    });
+  }
+};
+
+}  // namespace
+
 GridCells build_grid_cells(const GridLayout& g, size_t n, const CellInserter& insert) {
   GridCells cells;
-  const size_t blocks = (n + kBlock - 1) / kBlock;
-  cells.offsets.assign(g.cells() + 1, 0);
-  std::vector<std::vector<uint64_t>> pairs(blocks);
-  // Pass 1: the (cell, id) pairs of each block, and the per-cell counts.
+  const size_t blocks = (n + kBlock - 1) / kBlock, cell_count = g.cells();
+  std::vector<std::vector<uint64_t>> block_pairs(blocks);
+  // Pass 1: the (cell, id) pairs of each block of primitives.
   tbb::parallel_for(size_t(0), blocks, [&](size_t blk) {
     const size_t begin = blk * kBlock, end = std::min(n, begin + kBlock);
-    for (size_t i = begin; i < end; ++i) insert(uint32_t(i), pairs[blk]);
-    for (uint64_t p : pairs[blk]) std::atomic_ref<uint32_t>(cells.offsets[(p >> 32) + 1]).fetch_add(1, std::memory_order_relaxed);
+    for (size_t i = begin; i < end; ++i) insert(uint32_t(i), block_pairs[blk]);
   });
-  for (size_t c = 1; c < cells.offsets.size(); ++c) cells.offsets[c] += cells.offsets[c - 1];
-  // Pass 2: fill in block order, so the ids of a cell come out ascending.
-  cells.ids.resize(cells.offsets.back());
-  std::vector<uint32_t> cursor(cells.offsets.begin(), cells.offsets.end() - 1);
-  for (const auto& block : pairs)
-    for (uint64_t p : block) cells.ids[cursor[p >> 32]++] = uint32_t(p);
+  // Pass 2: regroup by bucket of cells, keeping primitive order.
+  const BucketedPairs bucketed(cell_count, block_pairs);
+  std::vector<std::vector<uint64_t>>().swap(block_pairs);
+  // Pass 3: each bucket counts, offsets and fills its own cells (primitive order: ids ascending per cell).
+  cells.offsets.resize(cell_count + 1);
+  cells.ids.resize(bucketed.begin.back());
+  cells.offsets[cell_count] = uint32_t(bucketed.begin.back());
+  tbb::parallel_for(size_t(0), bucketed.buckets, [&](size_t b) {
+    const size_t c0 = b << bucketed.shift, c1 = std::min(cell_count, (b + 1) << bucketed.shift);
+    const uint64_t* first = bucketed.pairs.get() + bucketed.begin[b];
+    const uint64_t* last = bucketed.pairs.get() + bucketed.begin[b + 1];
+    std::vector<uint32_t> cursor(c1 - c0, 0);
+    for (const uint64_t* p = first; p != last; ++p) ++cursor[(*p >> 32) - c0];
+    uint32_t running = uint32_t(bucketed.begin[b]);
+    for (size_t c = c0; c < c1; ++c) {  // offsets, and the cursor of each cell at its first slot
+      cells.offsets[c] = running;
+      std::swap(cursor[c - c0], running);
+      running += cursor[c - c0];
+    }
+    for (const uint64_t* p = first; p != last; ++p) cells.ids[cursor[(*p >> 32) - c0]++] = uint32_t(*p);
+  });
   return cells;
 }
 
