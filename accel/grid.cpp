@@ -249,6 +249,7 @@ GridCells build_grid_cells(const GridLayout& g, size_t n, const CellInserter& in
   // Pass 1: the (cell, id) pairs of each block of primitives.
   tbb::parallel_for(size_t(0), blocks, [&](size_t blk) {
     const size_t begin = blk * kBlock, end = std::min(n, begin + kBlock);
+    block_pairs[blk].reserve(4 * (end - begin));  // typical references per primitive: fewer regrowths
     for (size_t i = begin; i < end; ++i) insert(uint32_t(i), block_pairs[blk]);
   });
   // Pass 2: regroup by bucket of cells, keeping primitive order.
