@@ -193,11 +193,11 @@ BvhConfig read_bvh_config(BvhMethod method, Params& params) {
 
 namespace {
 const Registrar kRegisterMedian{structure_info<BvhMedian>(
-    "bvh-median", "binary BVH, object median of centroids on the longest axis", 60)};
+    "bvh-median", "BVH, object median of centroids on the longest axis (width=2|8)", 60)};
 const Registrar kRegisterSah{
-    structure_info<BvhSah>("bvh-sah", "binary BVH, binned SAH (Wald 2007), parallel build", 61)};
+    structure_info<BvhSah>("bvh-sah", "BVH, binned SAH (Wald 2007), parallel build; 8-wide (default) or binary (width=2)", 61)};
 const Registrar kRegisterSweep{
-    structure_info<BvhSweep>("bvh-sweep", "binary BVH, full sweep SAH on all axes (quality reference)", 62)};
+    structure_info<BvhSweep>("bvh-sweep", "BVH, full sweep SAH on all axes (quality reference; width=2|8)", 62)};
 }  // namespace
 
 }  // namespace ab

@@ -37,6 +37,17 @@ std::unique_ptr<Accelerator> make_accelerator(const std::string& name, std::shar
   return accel;
 }
 
+std::shared_ptr<const TrianglePrims> one_triangle_prims() {
+  auto mesh = std::make_shared<Mesh>();
+  mesh->vertices = {vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0)};
+  mesh->triangles = {glm::uvec3(0, 1, 2)};
+  return std::make_shared<const TrianglePrims>(std::move(mesh));
+}
+
+nlohmann::json default_params(const std::string& name) {
+  return make_accelerator(name, one_triangle_prims(), Params())->config();
+}
+
 std::unique_ptr<Accelerator> make_instance_accelerator(const std::string& name,
                                                        std::shared_ptr<const InstancePrims> prims, Params params) {
   const AcceleratorInfo& info = find_accelerator(name);

@@ -41,6 +41,12 @@ struct Registrar {
   explicit Registrar(AcceleratorInfo info);
 };
 
+/// One triangle as a primitive set: enough to create (not build) any structure and read its parameters.
+std::shared_ptr<const TrianglePrims> one_triangle_prims();
+
+/// The effective parameters of `name` with every default (the structure created over one triangle).
+nlohmann::json default_params(const std::string& name);
+
 /// Every registered accelerator, in listing order.
 const std::vector<AcceleratorInfo>& accelerators();
 /// The accelerator called name; throws UnknownAccelerator.

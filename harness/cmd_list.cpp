@@ -22,7 +22,8 @@ nlohmann::json listing() {
     j["accelerators"].push_back({{"name", a.name},
                                  {"description", a.description},
                                  {"reference", a.is_reference},
-                                 {"top_level", static_cast<bool>(a.make_for_instances)}});
+                                 {"top_level", static_cast<bool>(a.make_for_instances)},
+                                 {"params", default_params(a.name)}});
   }
   j["generators"] = nlohmann::json::array();
   for (const auto& g : generators()) j["generators"].push_back({{"name", g.name}, {"description", g.description}});
@@ -34,11 +35,17 @@ nlohmann::json listing() {
   return j;
 }
 
+/// One line per item; items with parameters get a second line listing them with their defaults.
 void print_section(const std::string& title, const nlohmann::json& items) {
   std::cout << title << ":\n";
-  for (const auto& item : items)
+  for (const auto& item : items) {
     std::cout << "  " << std::left << std::setw(16) << item["name"].get<std::string>() << " "
               << item["description"].get<std::string>() << "\n";
+    if (!item.contains("params") || item["params"].empty()) continue;
+    std::cout << "  " << std::setw(16) << "" << " params:";
+    for (const auto& [k, v] : item["params"].items()) std::cout << " " << k << "=" << (v.is_string() ? v.get<std::string>() : v.dump());
+    std::cout << "\n";
+  }
 }
 
 const CommandRegistrar kList{{"list", "names of accelerators, mesh generators and ray kinds", 10,

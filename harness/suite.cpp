@@ -372,10 +372,7 @@ namespace {
 
 void validate_accelerators(const Suite& suite) {
   // A tiny mesh: each configuration is created (parameters read and checked), never built.
-  auto mesh = std::make_shared<Mesh>();
-  mesh->vertices = {vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0)};
-  mesh->triangles = {glm::uvec3(0, 1, 2)};
-  auto prims = std::make_shared<const TrianglePrims>(mesh);
+  const auto prims = one_triangle_prims();
   std::vector<std::string> names{suite.verify.reference};
   for (const auto& a : suite.accelerators) {
     const Where w{suite.source, a.field};

@@ -69,7 +69,11 @@ TEST_F(Cli, HelpAndListWork) {
   ASSERT_EQ(r.code, 0);
   const auto j = nlohmann::json::parse(r.out);
   std::vector<std::string> names;
-  for (const auto& a : j["accelerators"]) names.push_back(a["name"]);
+  for (const auto& a : j["accelerators"]) {
+    names.push_back(a["name"]);
+    if (a["name"] == "bvh-sah") EXPECT_EQ(a["params"]["width"], 8);  // parameters with their defaults
+    if (a["name"] == "grid") EXPECT_TRUE(a["params"].contains("lambda"));
+  }
   EXPECT_NE(std::find(names.begin(), names.end(), "brute"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "embree"), names.end());
   EXPECT_GE(j["generators"].size(), 7u);
