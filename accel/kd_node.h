@@ -57,6 +57,12 @@ class KdNode {
       bits_ += node_base << 4;
     }
   }
+  /// This interior node with another above child and empty-child flags (drop_empty_leaves).
+  KdNode relinked(uint32_t above, bool below_empty, bool above_empty) const {
+    return interior(axis(), split(), above, below_empty, above_empty);
+  }
+  /// Largest node index an interior node can hold.
+  static constexpr uint32_t kMaxIndex = (1u << 28) - 1;
 
  private:
   KdNode(uint32_t word, uint32_t bits) : word_(word), bits_(bits) {}
@@ -64,9 +70,6 @@ class KdNode {
   uint32_t bits_;
 };
 static_assert(sizeof(KdNode) == 8);
-
-/// Largest node index an interior KdNode can hold.
-inline constexpr uint32_t kKdMaxIndex = (1u << 28) - 1;
 
 /// Nodes in depth-first order (below child next to its parent) and the leaves' primitive indices.
 struct KdBuffer {
@@ -91,8 +94,11 @@ struct KdBuffer {
 };
 
 /// Removes the empty leaves of a depth-first tree (all but an empty root): their parents flag them instead.
-/// Throws InputError when the remaining nodes do not fit the node's index field.
-inline void drop_empty_leaves(std::vector<KdNode>& nodes) {
+/// Node provides is_leaf(), count(), above() and relinked(above, below_empty, above_empty) (a copy of an
+/// interior node with a new above index and flags), and kMaxIndex. Throws InputError when the remaining
+/// nodes do not fit the node's index field. Shared by the k-d trees and the BSP tree.
+template <class Node>
+void drop_empty_leaves(std::vector<Node>& nodes) {
   const size_t n = nodes.size();
   auto empty = [&](size_t i) { return i != 0 && nodes[i].is_leaf() && nodes[i].count() == 0; };
   std::vector<uint32_t> remap(n);
@@ -101,11 +107,11 @@ inline void drop_empty_leaves(std::vector<KdNode>& nodes) {
     remap[i] = uint32_t(kept);
     kept += !empty(i);
   }
-  if (kept > kKdMaxIndex) throw InputError("k-d tree: more than 2^28 nodes (mesh too large for this structure)");
-  std::vector<KdNode> out;
+  if (kept > Node::kMaxIndex) throw InputError("tree of more nodes than its node format can index (mesh too large)");
+  std::vector<Node> out;
   out.reserve(kept);
   for (size_t i = 0; i < n; ++i) {
-    const KdNode& nd = nodes[i];
+    const Node& nd = nodes[i];
     if (empty(i)) continue;
     if (nd.is_leaf()) {
       out.push_back(nd);
@@ -113,8 +119,7 @@ inline void drop_empty_leaves(std::vector<KdNode>& nodes) {
     }
     const bool below_empty = empty(i + 1);
     const bool above_empty = empty(nd.above()) && !below_empty;  // a split always keeps one side
-    out.push_back(KdNode::interior(nd.axis(), nd.split(), above_empty ? 0 : remap[nd.above()], below_empty,
-                                   above_empty));
+    out.push_back(nd.relinked(above_empty ? 0 : remap[nd.above()], below_empty, above_empty));
   }
   nodes.swap(out);
 }
@@ -192,22 +197,26 @@ bool occluded_id_list(const P& prims, const uint32_t* ids, uint32_t count, const
   return false;
 }
 
-/// The leaves' primitive references in leaf order: the original ids and, for triangle sets, a copy of each
-/// referenced triangle in the same order, so that a leaf reads its triangles from one contiguous run (as the
-/// BVH's leaves do) instead of gathering them by id. A triangle referenced by several leaves is copied once
-/// per reference. Other primitive sets (instances) are reached through their ids.
+/// The leaves' primitive references in leaf order: the original ids and, for triangle sets when asked, a
+/// copy of each referenced triangle in the same order, so that a leaf reads its triangles from one
+/// contiguous run (as the BVH's leaves do) instead of gathering them by id. A triangle referenced by several
+/// leaves is copied once per reference (36 bytes each), which is why it is optional. Other primitive sets
+/// (instances) are always reached through their ids.
 template <class P>
 class LeafRefs {
  public:
-  /// True when triangles are copied into leaf order.
-  static constexpr bool kCopies = std::is_same_v<P, TrianglePrims>;
+  /// True when the primitive set can be copied into leaf order.
+  static constexpr bool kCanCopy = std::is_same_v<P, TrianglePrims>;
 
-  /// Takes the leaf-ordered ids and copies the triangles they name.
-  void assign(const P& prims, std::vector<uint32_t> ids) {
+  /// Takes the leaf-ordered ids and, when `copy` is set, copies the triangles they name.
+  void assign(const P& prims, std::vector<uint32_t> ids, bool copy) {
     ids_ = std::move(ids);
-    if constexpr (kCopies) {
-      tris_.resize(ids_.size());
-      for (size_t k = 0; k < ids_.size(); ++k) tris_[k] = prims.triangle(ids_[k]);
+    tris_.clear();
+    if constexpr (kCanCopy) {
+      if (copy) {
+        tris_.resize(ids_.size());
+        for (size_t k = 0; k < ids_.size(); ++k) tris_[k] = prims.triangle(ids_[k]);
+      }
     }
   }
   /// The leaf-ordered ids.
@@ -219,31 +228,34 @@ class LeafRefs {
   template <bool kCount>
   [[gnu::always_inline]] void intersect(const P& prims, uint32_t first, uint32_t count, const Ray& ray, Hit& best,
                                         uint32_t inst, RayCounters& c) const {
-    if constexpr (kCopies) {
-      if constexpr (kCount) c.prims += count;
-      for (uint32_t k = first, e = first + count; k < e; ++k) {
-        TriangleHit th;  // the id (another array) is read only for a hit
-        if (intersect_triangle(ray, tris_[k], th) && is_better_hit(th.t, inst, ids_[k], best))
-          best = {th.t, ids_[k], inst, th.u, th.v};
+    if constexpr (kCanCopy) {
+      if (!tris_.empty()) {
+        if constexpr (kCount) c.prims += count;
+        for (uint32_t k = first, e = first + count; k < e; ++k) {
+          TriangleHit th;  // the id (another array) is read only for a hit
+          if (intersect_triangle(ray, tris_[k], th) && is_better_hit(th.t, inst, ids_[k], best))
+            best = {th.t, ids_[k], inst, th.u, th.v};
+        }
+        return;
       }
-    } else {
-      intersect_id_list<kCount>(prims, ids_.data() + first, count, ray, best, inst, c);
     }
+    intersect_id_list<kCount>(prims, ids_.data() + first, count, ray, best, inst, c);
   }
   /// True when any reference in [first, first + count) blocks the ray.
   template <bool kCount>
   [[gnu::always_inline]] bool occluded(const P& prims, uint32_t first, uint32_t count, const Ray& ray,
                                        RayCounters& c) const {
-    if constexpr (kCopies) {
-      for (uint32_t k = first, e = first + count; k < e; ++k) {
-        if constexpr (kCount) ++c.prims;
-        TriangleHit th;
-        if (intersect_triangle(ray, tris_[k], th)) return true;
+    if constexpr (kCanCopy) {
+      if (!tris_.empty()) {
+        for (uint32_t k = first, e = first + count; k < e; ++k) {
+          if constexpr (kCount) ++c.prims;
+          TriangleHit th;
+          if (intersect_triangle(ray, tris_[k], th)) return true;
+        }
+        return false;
       }
-      return false;
-    } else {
-      return occluded_id_list<kCount>(prims, ids_.data() + first, count, ray, c);
     }
+    return occluded_id_list<kCount>(prims, ids_.data() + first, count, ray, c);
   }
 
  private:

@@ -36,6 +36,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       median_.cycle_axes = params.get_choice("axis", "longest", {"longest", "cycle"}) == "cycle";
     }
     max_depth_ = int(params.get_int("max_depth", 0, 0, 100));
+    leaf_copies_ = params.get_bool("leaf_copies", true);
     config_ = params.effective();
   }
 
@@ -88,8 +89,10 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       }
     }
     drop_empty_leaves(out.nodes);
+    margin_ = ids.empty() ? 0.0f : insertion_margin(box_);
+    root_box_ = {box_.lo - vec3(margin_), box_.hi + vec3(margin_)};
     nodes_ = std::move(out.nodes);
-    leaves_.assign(*prims_, std::move(out.prims));
+    leaves_.assign(*prims_, std::move(out.prims), leaf_copies_);
     fill_stats(depth);
   }
 
@@ -107,8 +110,8 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   template <bool kCount, class Leaf, class BestT>
   [[gnu::always_inline]] bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
     float t0 = ray.tmin, t1 = ray.tmax;
-    if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
-    const AxisRay r(ray);
+    if (nodes_.empty() || !slab_test(root_box_, RayBoxData(ray), t0, t1)) return false;
+    const AxisRay r(ray, margin_);
     const KdNode* nodes = nodes_.data();
     StackItem stack[kStackSize];
     int sp = 0;
@@ -197,8 +200,11 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   KdSahSettings sah_;
   KdMedianSettings median_;
   int max_depth_ = 0;
+  bool leaf_copies_ = true;  ///< copy triangles into leaf order (LeafRefs)
   nlohmann::json config_;
   AABB box_;
+  AABB root_box_;       ///< box_ grown by margin_ (the traversal's first clip)
+  float margin_ = 0.0f;  ///< positional band of every plane crossing (AxisRay)
   std::vector<KdNode> nodes_;
   LeafRefs<P> leaves_;
   std::vector<uint32_t> unbounded_;

@@ -75,25 +75,38 @@ struct AxisCrossing {
 };
 
 /// A ray prepared for many axis-aligned plane steps (the k-d tree's inner loop, after pbrt's
-/// KdTreeAggregate): origin, reciprocal direction and the side met first, per axis. The step is the
-/// same as split_at_axis_plane but written for a tight loop: the near side comes from the sign bit
-/// of the direction, so a zero component (t_split = +-inf, or NaN when the origin lies in the plane)
-/// needs no branch: +-inf keeps the ray on its side, and NaN makes both comparisons false, so both
-/// sides are visited over the whole interval (std::max(t0, NaN) is t0 and std::min(t1, NaN) is t1).
+/// KdTreeAggregate): origin, reciprocal direction, the side met first and a positional band, per axis.
+/// The crossing is widened relatively (kBoxEps, as slab_test) and by `margin` in position (margin / |dir|
+/// in t): the kernel may accept a hit a few ulps of the coordinates outside a triangle that touches the
+/// plane and was placed on one side only, and near t = 0 a relative widening is no widening at all. The
+/// near side comes from the sign bit of the direction. A zero component gives t_split = +-inf (the ray
+/// stays on its side) unless the origin lies within the margin of the plane: then both sides are visited
+/// over the whole interval (NaN crossings: std::max(t0, NaN) is t0 and std::min(t1, NaN) is t1).
 struct AxisRay {
-  float org[3], inv[3];
-  bool below_first[3];
+  float org[3], inv[3], band[3];
+  bool below_first[3], parallel[3];
+  float margin;
 
-  /// From ray r.
-  explicit AxisRay(const Ray& r)
+  /// From ray r and the positional margin of the tree.
+  AxisRay(const Ray& r, float margin_)
       : org{r.org.x, r.org.y, r.org.z},
         inv{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z},
-        below_first{!std::signbit(r.dir.x), !std::signbit(r.dir.y), !std::signbit(r.dir.z)} {}
+        below_first{!std::signbit(r.dir.x), !std::signbit(r.dir.y), !std::signbit(r.dir.z)},
+        margin(margin_) {
+    for (int a = 0; a < 3; ++a) {
+      parallel[a] = !(std::fabs(inv[a]) < kInf);
+      band[a] = parallel[a] ? 0.0f : margin * std::fabs(inv[a]);
+    }
+  }
 
   /// The crossing of plane coordinate `split` on axis a.
   [[gnu::always_inline]] AxisCrossing cross(int a, float split) const {
     const float t = (split - org[a]) * inv[a];
-    return {widen_near(t), widen_far(t), below_first[a]};
+    if (parallel[a]) [[unlikely]] {
+      if (std::fabs(split - org[a]) <= margin) return {std::nanf(""), std::nanf(""), below_first[a]};
+      return {t, t, below_first[a]};
+    }
+    return {widen_near(t) - band[a], widen_far(t) + band[a], below_first[a]};
   }
 };
 

@@ -127,11 +127,18 @@ TEST(SplitPlane, AxisRayCrossingsAreWidenedAndZeroDirectionsNeedNoBranch) {
   Ray ray;
   ray.org = {0.0f, 1.0f, 2.0f};
   ray.dir = {0.5f, 0.0f, -0.0f};
-  const AxisRay r(ray);
+  const AxisRay r(ray, 0.0f);
   const AxisCrossing x = r.cross(0, 1.0f);  // crossing at t = 2, below side first
   EXPECT_TRUE(x.below_first);
   EXPECT_LT(x.near, 2.0f);
   EXPECT_GT(x.far, 2.0f);
+  // With a positional margin, a crossing at (almost) t = 0 is widened by margin / |dir| both ways.
+  const AxisRay m(ray, 0.01f);
+  const AxisCrossing at_origin = m.cross(0, 1e-9f);
+  EXPECT_LE(at_origin.near, -0.019f);
+  EXPECT_GE(at_origin.far, 0.019f);
+  EXPECT_FALSE(m.cross(1, 1.005f).near > 10.0f);  // parallel within the margin: both sides
+  EXPECT_TRUE(m.cross(1, 0.5f).far < 0.0f);       // parallel beyond it: one side
   const AxisCrossing above = r.cross(1, 0.5f);  // parallel, origin above: never reaches the below side
   EXPECT_TRUE(above.below_first);
   EXPECT_TRUE(above.far < 0.0f);  // -inf: the first (below) side is skipped
@@ -205,6 +212,18 @@ TEST(KdTree, MatchesBruteOnAdversarialMeshesAndInstances) {
     EXPECT_EQ(testing::count_instance_differences(name, inst, adversarial_rays(random_soup(50, 1), 2000, 4)), 0u)
         << name;
   }
+}
+
+TEST(KdTree, LeafCopiesOnOrOffGiveTheSameHitsAsBrute) {
+  Mesh mesh = adversarial_mesh(5);
+  const Mesh soup = random_soup(400, 6);
+  const uint32_t base = uint32_t(mesh.vertices.size());
+  mesh.vertices.insert(mesh.vertices.end(), soup.vertices.begin(), soup.vertices.end());
+  for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
+  const std::vector<Ray> rays = adversarial_rays(mesh, 2000, 22);
+  for (const char* name : {"kdtree-sah", "kdtree-median", "bsp"})
+    for (const char* copies : {"0", "1"})
+      EXPECT_EQ(count_differences(name, mesh, rays, {{"leaf_copies", copies}}), 0u) << name << " " << copies;
 }
 
 TEST(KdTree, EmptyMeshAndSingleTriangle) {
