@@ -21,30 +21,47 @@
 
 namespace ab {
 
-/// One BSP node (8 bytes): an interior node (index of its plane, index of the above child; the below
-/// child follows it) or a leaf (offset and count of its primitive indices).
+/// One BSP node (8 bytes): an interior node (index of its plane, index of the above child and a flag per
+/// child that is an empty leaf; the below child, when not empty, follows it) or a leaf (offset and count
+/// of its primitive indices). Empty children are flags, not nodes (drop_empty_leaves, kd_node.h).
 class BspNode {
  public:
   /// A leaf of `count` primitive indices starting at `first`.
   static BspNode leaf(uint32_t first, uint32_t count) { return BspNode(first, (count << 1) | 1u); }
   /// An interior node split by plane `plane`, above child `above`.
-  static BspNode interior(uint32_t plane, uint32_t above) { return BspNode(plane, above << 1); }
+  static BspNode interior(uint32_t plane, uint32_t above, bool below_empty = false, bool above_empty = false) {
+    return BspNode(plane, (above << 3) | (uint32_t(above_empty) << 2) | (uint32_t(below_empty) << 1));
+  }
 
   /// True for a leaf.
   bool is_leaf() const { return bits_ & 1u; }
-  /// Plane index (interior) or first primitive index (leaf).
+  /// Plane index (interior nodes).
+  uint32_t plane() const { return word_; }
+  /// Above child (interior nodes); the below child is this node's index + 1.
+  uint32_t above() const { return bits_ >> 3; }
+  /// True when the below child is an empty leaf (interior nodes).
+  bool below_empty() const { return (bits_ & 2u) != 0; }
+  /// True when the above child is an empty leaf (interior nodes).
+  bool above_empty() const { return (bits_ & 4u) != 0; }
+  /// First primitive index (leaves).
   uint32_t first() const { return word_; }
-  /// Above child (interior) or primitive count (leaf).
-  uint32_t second() const { return bits_ >> 1; }
+  /// Primitive count (leaves).
+  uint32_t count() const { return bits_ >> 1; }
   /// Moves the node by the given bases (splicing buffers).
   void rebase(uint32_t node_base, uint32_t prim_base, uint32_t plane_base) {
     if (is_leaf()) {
       word_ += prim_base;
     } else {
       word_ += plane_base;
-      bits_ += node_base << 1;
+      bits_ += node_base << 3;
     }
   }
+  /// This interior node with another above child and empty-child flags (drop_empty_leaves).
+  BspNode relinked(uint32_t above, bool below_empty, bool above_empty) const {
+    return interior(plane(), above, below_empty, above_empty);
+  }
+  /// Largest node index an interior node can hold.
+  static constexpr uint32_t kMaxIndex = (1u << 29) - 1;
 
  private:
   BspNode(uint32_t word, uint32_t bits) : word_(word), bits_(bits) {}
@@ -77,8 +94,8 @@ inline bool is_oblique(const BspPlane& p) { return !(p.n.x == 1.0f || p.n.y == 1
 /// Settings of the BSP builder.
 struct BspSettings {
   float traversal_cost = 1.0f;
-  float intersection_cost = 1.5f;
-  float empty_bonus = 0.2f;
+  float intersection_cost = 1.8f;  ///< measured on slivers: fewer triangles per ray at about the same nodes
+  float empty_bonus = 0.05f;       ///< small: 13 directions offer many corner cuts, each one more level
   int bins = 16;             ///< plane positions per fixed direction: bins - 1
   int autopartition = 8;     ///< triangles whose supporting planes are tried per node
   int max_depth = 0;         ///< resolved depth limit
@@ -94,7 +111,7 @@ class BspBuilder {
 
   /// Builds over ids (finite bounds) inside box into out.
   void build(std::vector<uint32_t> ids, const AABB& box, BspBuffer& out) const {
-    build_node(std::move(ids), ConvexCell::from_box(box), {}, 0, out);
+    build_node(std::move(ids), ConvexCell::from_box(box), {}, Depth{}, out);
   }
 
  private:
@@ -149,13 +166,22 @@ class BspBuilder {
     return poly.n;
   }
 
-  void build_node(std::vector<uint32_t>&& ids, const ConvexCell& cell, const std::vector<HalfSpace>& path, int depth,
+  /// Depth of a node: all levels, and the splits with primitives on both sides. A split with an empty side
+  /// (cutting off empty space, often a corner of the cell by an oblique plane) never puts an entry on the
+  /// traversal stack, so only the other splits count against max_depth; the levels have their own bound.
+  struct Depth {
+    int levels = 0, splits = 0;
+  };
+  static constexpr int kEmptyCutLevels = 32;
+
+  void build_node(std::vector<uint32_t>&& ids, const ConvexCell& cell, const std::vector<HalfSpace>& path, Depth depth,
                   BspBuffer& out) const {
     NodePrims np = gather(ids, cell, path);
     std::vector<uint32_t>().swap(ids);
     const size_t n = np.size();
     Choice best;
-    if (n > 1 && depth < s_.max_depth) best = find_plane(np, cell);
+    if (n > 1 && depth.splits < s_.max_depth && depth.levels < s_.max_depth + kEmptyCutLevels)
+      best = find_plane(np, cell);
     std::vector<uint32_t> left, right;
     if (best.cost < s_.intersection_cost * float(n)) partition(np, best.plane, left, right);
     if ((left.empty() && right.empty()) || (left.size() == n && right.size() == n)) {
@@ -170,21 +196,22 @@ class BspBuilder {
       lpath.push_back({best.plane.n, best.plane.d + s_.margin});
       rpath.push_back({-best.plane.n, -best.plane.d + s_.margin});
     }
+    const Depth next{depth.levels + 1, depth.splits + int(!left.empty() && !right.empty())};
     const size_t self = out.nodes.size();
     const uint32_t plane = uint32_t(out.planes.size());
     out.planes.push_back(best.plane);
     out.nodes.push_back(BspNode::leaf(0, 0));
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lpath, depth + 1, lb); },
-                           [&] { build_node(std::move(right), rcell, rpath, depth + 1, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lpath, next, lb); },
+                           [&] { build_node(std::move(right), rcell, rpath, next, rb); });
       out.append(lb);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lcell, lpath, depth + 1, out);
+      build_node(std::move(left), lcell, lpath, next, out);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rcell, rpath, depth + 1, out);
+      build_node(std::move(right), rcell, rpath, next, out);
     }
   }
 
@@ -199,46 +226,55 @@ class BspBuilder {
     }
   }
 
-  float cost(const ConvexCell& cell, float inv_area, const BspPlane& plane, size_t nl, size_t nr) const {
-    float al = 0.0f, ar = 0.0f;
-    cell.areas(plane, al, ar);
+  /// SAH cost of a plane from the areas of the two parts and the counts on each side; infinite for a plane
+  /// that does not cut the cell (a part without area), which would only earn the empty bonus and repeat
+  /// itself down to the depth limit.
+  float cost(float inv_area, float al, float ar, size_t nl, size_t nr) const {
+    if (!(std::min(al, ar) * inv_area > 1e-5f)) return kInf;
     const float lambda = (nl == 0 || nr == 0) ? 1.0f - s_.empty_bonus : 1.0f;
     return lambda * (s_.traversal_cost + s_.intersection_cost * inv_area * (al * float(nl) + ar * float(nr)));
   }
 
   Choice find_plane(const NodePrims& np, const ConvexCell& cell) const {
     Choice best;
-    const float area = cell.area();
+    const CellSurface surface(cell);
+    const float area = surface.area();
     if (!(area > 0.0f)) return best;
     const float inv_area = 1.0f / area;
-    for (const vec3& dir : bsp_directions()) binned_planes(np, cell, inv_area, dir, best);
+    for (const vec3& dir : bsp_directions()) binned_planes(np, surface, inv_area, dir, best);
     const size_t k = std::min<size_t>(np.size(), size_t(s_.autopartition));
     for (size_t j = 0; j < k; ++j) {
       BspPlane own;
       if (!supporting_plane(prims_, np.ids[j * np.size() / k], own)) continue;
       // The plane itself and the plane moved two margins to either side, which puts the primitives
       // lying in it on one side only (like the planar events of Wald and Havran 2006).
-      for (float shift : {0.0f, -2.0f * s_.margin, 2.0f * s_.margin}) {
-        const BspPlane plane{own.n, own.d + shift};
+      const float d[3] = {own.d, own.d - 2.0f * s_.margin, own.d + 2.0f * s_.margin};
+      float al[3], ar[3];
+      surface.areas(own.n, d, al, ar);
+      for (int m = 0; m < 3; ++m) {
+        const BspPlane plane{own.n, d[m]};
         size_t nl = 0, nr = 0;
         for (size_t i = 0; i < np.size(); ++i) {
           const int s = side(np, i, plane);
           nl += s & 1;
           nr += s >> 1;
         }
-        const float c = cost(cell, inv_area, plane, nl, nr);
+        const float c = cost(inv_area, al[m], ar[m], nl, nr);
         if (c < best.cost) best = {plane, c};
       }
     }
     return best;
   }
 
-  /// Planes of direction dir at the bin boundaries of the clipped primitives' extents (Wald 2007's
-  /// binning, a primitive counted on every side its extent reaches).
-  void binned_planes(const NodePrims& np, const ConvexCell& cell, float inv_area, const vec3& dir,
+  /// Candidate planes of direction dir. A node of at most `bins` primitives tries the planes just outside
+  /// each primitive's extent (two margins, so the primitive is classified on one side only), like the events
+  /// of a k-d sweep; a larger node the bin boundaries of the extents (Wald 2007's binning, a primitive
+  /// counted on every side its extent reaches) and two planes just outside all extents. A plane with an
+  /// empty side must cut off at least 1/bins of the cell's extent, or each node would shave off another
+  /// sliver (its primitives clipped a little tighter) down to the depth limit.
+  void binned_planes(const NodePrims& np, const CellSurface& surface, float inv_area, const vec3& dir,
                      Choice& best) const {
     const size_t n = np.size();
-    const int bins = int(std::min<size_t>(size_t(s_.bins), n + 1));
     std::vector<float> lo(n), hi(n);
     float range_lo = kInf, range_hi = -kInf;
     for (size_t i = 0; i < n; ++i) {
@@ -247,20 +283,69 @@ class BspBuilder {
       range_hi = std::max(range_hi, hi[i]);
     }
     if (!(range_hi > range_lo)) return;
+    std::vector<float> d;
+    std::vector<uint32_t> nl, nr;
+    if (n <= size_t(s_.bins)) {
+      exact_candidates(lo, hi, d, nl, nr);
+    } else {
+      binned_candidates(lo, hi, range_lo, range_hi, d, nl, nr);
+    }
+    float cell_lo, cell_hi;
+    surface.extent(dir, cell_lo, cell_hi);
+    const float min_gap = (cell_hi - cell_lo) / float(s_.bins);
+    std::vector<float> al(d.size()), ar(d.size());
+    surface.areas(dir, d, al.data(), ar.data());
+    for (size_t j = 0; j < d.size(); ++j) {
+      if (nl[j] == 0 && !(d[j] - cell_lo >= min_gap)) continue;
+      if (nr[j] == 0 && !(cell_hi - d[j] >= min_gap)) continue;
+      const float c = cost(inv_area, al[j], ar[j], nl[j], nr[j]);
+      if (c < best.cost) best = {BspPlane{dir, d[j]}, c};
+    }
+  }
+
+  /// Planes two margins below each extent's start and above each extent's end, with exact counts.
+  void exact_candidates(const std::vector<float>& lo, const std::vector<float>& hi, std::vector<float>& d,
+                        std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
+    for (size_t k = 0; k < lo.size(); ++k) {
+      d.push_back(lo[k] - 2.0f * s_.margin);
+      d.push_back(hi[k] + 2.0f * s_.margin);
+    }
+    for (const float x : d) {
+      uint32_t l = 0, r = 0;
+      for (size_t k = 0; k < lo.size(); ++k) {  // the classification of side()
+        l += lo[k] - x <= s_.margin;
+        r += hi[k] - x >= -s_.margin;
+      }
+      nl.push_back(l);
+      nr.push_back(r);
+    }
+  }
+
+  /// The bin boundaries and the planes two margins outside the whole range, with binned counts.
+  void binned_candidates(const std::vector<float>& lo, const std::vector<float>& hi, float range_lo, float range_hi,
+                         std::vector<float>& d, std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
+    const size_t n = lo.size();
+    const int bins = s_.bins;
     std::vector<uint32_t> starts(bins, 0), ends(bins, 0);
     const float scale = float(bins) / (range_hi - range_lo);
     for (size_t i = 0; i < n; ++i) {
       ++starts[std::clamp(int((lo[i] - range_lo) * scale), 0, bins - 1)];
       ++ends[std::clamp(int((hi[i] - range_lo) * scale), 0, bins - 1)];
     }
-    size_t nl = 0, nr = n;
+    d.push_back(range_lo - 2.0f * s_.margin);
+    nl.push_back(0);
+    nr.push_back(uint32_t(n));
+    uint32_t l = 0, r = uint32_t(n);
     for (int j = 1; j < bins; ++j) {
-      nl += starts[j - 1];
-      nr -= ends[j - 1];
-      const BspPlane plane{dir, range_lo + (range_hi - range_lo) * float(j) / float(bins)};
-      const float c = cost(cell, inv_area, plane, nl, nr);
-      if (c < best.cost) best = {plane, c};
+      l += starts[j - 1];
+      r -= ends[j - 1];
+      d.push_back(range_lo + (range_hi - range_lo) * float(j) / float(bins));
+      nl.push_back(l);
+      nr.push_back(r);
     }
+    d.push_back(range_hi + 2.0f * s_.margin);
+    nl.push_back(uint32_t(n));
+    nr.push_back(0);
   }
 
   /// Side of primitive k: bit 0 below, bit 1 above (both when its clipped part comes within the margin).
@@ -279,7 +364,7 @@ class BspBuilder {
     }
   }
 
-  static constexpr size_t kParallelMin = 8192;
+  static constexpr size_t kParallelMin = 256;  // BSP nodes are costly: split the work deep
   const P& prims_;
   BspSettings s_;
 };
@@ -291,11 +376,12 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   /// Reads the configuration from params.
   BspTree(std::shared_ptr<const P> prims, Params& params) : prims_(std::move(prims)) {
     s_.traversal_cost = float(params.get_float("traversal_cost", 1.0, 1e-3, 1e6));
-    s_.intersection_cost = float(params.get_float("intersection_cost", 1.5, 1e-3, 1e6));
-    s_.empty_bonus = float(params.get_float("empty_bonus", 0.2, 0.0, 0.99));
+    s_.intersection_cost = float(params.get_float("intersection_cost", 1.8, 1e-3, 1e6));
+    s_.empty_bonus = float(params.get_float("empty_bonus", 0.05, 0.0, 0.99));
     s_.bins = int(params.get_int("bins", 16, 2, 256));
     s_.autopartition = int(params.get_int("autopartition", 8, 0, 1024));
     max_depth_ = int(params.get_int("max_depth", 0, 0, 100));
+    leaf_copies_ = params.get_bool("leaf_copies", false);  // ~15 references per triangle on slivers
     config_ = params.effective();
   }
 
@@ -305,10 +391,11 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
 
   /// Closest hit, front to back.
   template <bool kCount>
-  void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
+  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+    if (!unbounded_.empty())
+      intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
     auto leaf = [&](const BspNode& n) {
-      intersect_id_list<kCount>(*prims_, &ids_[n.first()], n.second(), ray, best, inst, c);
+      leaves_.template intersect<kCount>(*prims_, n.first(), n.count(), ray, best, inst, c);
       return false;
     };
     traverse<kCount>(ray, c, leaf, [&] { return best.t; });
@@ -318,7 +405,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
     if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
-    auto leaf = [&](const BspNode& n) { return occluded_id_list<kCount>(*prims_, &ids_[n.first()], n.second(), ray, c); };
+    auto leaf = [&](const BspNode& n) { return leaves_.template occluded<kCount>(*prims_, n.first(), n.count(), ray, c); };
     return traverse<kCount>(ray, c, leaf, [] { return kInf; });
   }
 
@@ -331,9 +418,10 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
     margin_ = s.margin;
     BspBuffer out;
     if (!ids.empty()) BspBuilder<P>(*prims_, s).build(std::move(ids), box_, out);
+    drop_empty_leaves(out.nodes);
     nodes_ = std::move(out.nodes);
     planes_ = std::move(out.planes);
-    ids_ = std::move(out.prims);
+    leaves_.assign(*prims_, std::move(out.prims), leaf_copies_);
     fill_stats(s.max_depth);
   }
 
@@ -342,10 +430,10 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
     uint32_t node;
     float t0, t1;
   };
-  static constexpr int kStackSize = 128;
+  static constexpr int kStackSize = 128;  // one entry per split with both sides non-empty (max_depth <= 100)
 
   template <bool kCount, class Leaf, class BestT>
-  bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
+  [[gnu::always_inline]] bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
     const vec3 abs_org = glm::abs(ray.org);
@@ -357,7 +445,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
       if constexpr (kCount) ++c.nodes;
       if (n.is_leaf()) {
         if constexpr (kCount) ++c.leaves;
-        if (n.second() && leaf(n)) return true;
+        if (n.count() && leaf(n)) return true;
       } else if (step(n, cur, ray, abs_org, stack, sp)) {
         continue;
       }
@@ -367,21 +455,23 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
 
   /// One interior node: the plane step with a band that covers the rounding of n.o - d and the margin.
   [[gnu::always_inline]] bool step(const BspNode& n, StackItem& cur, const Ray& ray, const vec3& abs_org, StackItem* stack, int& sp) const {
-    const BspPlane& p = planes_[n.first()];
+    const BspPlane& p = planes_[n.plane()];
     const float org_dist = p.distance(ray.org);
     const float rate = glm::dot(p.n, ray.dir);
     const float band = margin_ + (std::fabs(p.d) + glm::dot(glm::abs(p.n), abs_org)) * 0x1p-20f;
     const float t_split = -org_dist / rate;
     const float widen = band / std::fabs(rate) + std::fabs(t_split) * kBoxEps;
     const PlaneVisit v = split_interval(org_dist, rate, t_split, widen, band, cur.t0, cur.t1);
-    const uint32_t below = cur.node + 1, above = n.second();
+    const uint32_t below = cur.node + 1, above = n.above();
     const uint32_t first = v.first_below ? below : above, second = v.first_below ? above : below;
-    if (v.visit_first) {
-      if (v.visit_second) stack[sp++] = {second, v.second_t0, cur.t1};
+    const bool visit_first = v.visit_first && !(v.first_below ? n.below_empty() : n.above_empty());
+    const bool visit_second = v.visit_second && !(v.first_below ? n.above_empty() : n.below_empty());
+    if (visit_first) {
+      if (visit_second) stack[sp++] = {second, v.second_t0, cur.t1};
       cur = {first, cur.t0, v.first_t1};
       return true;
     }
-    if (v.visit_second) {
+    if (visit_second) {
       cur = {second, v.second_t0, cur.t1};
       return true;
     }
@@ -403,7 +493,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
     st = BuildStats{};
     st.primitives = prims_->size();
     st.nodes = nodes_.size();
-    st.bytes = nodes_.size() * sizeof(BspNode) + planes_.size() * sizeof(BspPlane) + ids_.size() * 4 +
+    st.bytes = nodes_.size() * sizeof(BspNode) + planes_.size() * sizeof(BspPlane) + leaves_.bytes() +
                unbounded_.size() * 4;
     st.extra["depth_limit"] = depth_limit;
     st.extra["unbounded_primitives"] = unbounded_.size();
@@ -418,23 +508,28 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
       todo.pop_back();
       const BspNode& n = nodes_[i];
       if (n.is_leaf()) {
-        st.add_leaf(n.second(), depth);
+        st.add_leaf(n.count(), depth);
         continue;
       }
-      todo.push_back({n.second(), depth + 1});
-      todo.push_back({i + 1, depth + 1});
+      if (n.above_empty()) st.add_leaf(0, depth + 1);
+      else todo.push_back({n.above(), depth + 1});
+      if (n.below_empty()) st.add_leaf(0, depth + 1);
+      else todo.push_back({i + 1, depth + 1});
     }
+    st.extra["stored_nodes"] = nodes_.size();  // nodes: also the empty leaves, which are flags, not nodes
+    if (st.leaves > 0) st.nodes = 2 * st.leaves - 1;
   }
 
   std::shared_ptr<const P> prims_;
   BspSettings s_;
   int max_depth_ = 0;
+  bool leaf_copies_ = false;  ///< copy triangles into leaf order (LeafRefs)
   float margin_ = 0.0f;
   nlohmann::json config_;
   AABB box_;
   std::vector<BspNode> nodes_;
   std::vector<BspPlane> planes_;
-  std::vector<uint32_t> ids_;
+  LeafRefs<P> leaves_;
   std::vector<uint32_t> unbounded_;
 };
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <vector>
 
 namespace ab {
@@ -64,6 +65,9 @@ class ConvexCell {
     above += glm::length(sum_above);
   }
 
+  /// Faces (for CellSurface).
+  const std::vector<std::vector<vec3>>& faces() const { return faces_; }
+
   /// Bounds of the cell's vertices.
   AABB bounds() const {
     AABB b;
@@ -73,7 +77,20 @@ class ConvexCell {
   }
 
   /// The part on one side of plane, closed by the cut face.
+  /// A plane that does not cut the cell (every vertex within rounding of it or on one side, for example
+  /// one of the cell's own faces) leaves the whole cell on that side and nothing on the other, so no
+  /// face is ever duplicated.
   ConvexCell part(const BspPlane& p, bool below) const {
+    bool removes = false, keeps = false;
+    for (const auto& f : faces_)
+      for (const vec3& v : f) {
+        const float s = below ? p.distance(v) : -p.distance(v);
+        const float tol = 1e-6f * (1.0f + glm::length(v));
+        removes |= s > tol;
+        keeps |= s < -tol;
+      }
+    if (!keeps) return ConvexCell{};
+    if (!removes) return *this;
     ConvexCell out;
     std::vector<vec3> cut;
     for (const auto& f : faces_) {
@@ -127,9 +144,15 @@ class ConvexCell {
     c /= float(pts.size());
     const vec3 u = glm::normalize(std::fabs(n.x) < 0.9f ? glm::cross(n, vec3(1, 0, 0)) : glm::cross(n, vec3(0, 1, 0)));
     const vec3 w = glm::cross(n, u);
-    std::sort(pts.begin(), pts.end(), [&](const vec3& a, const vec3& b) {
-      return std::atan2(glm::dot(a - c, w), glm::dot(a - c, u)) < std::atan2(glm::dot(b - c, w), glm::dot(b - c, u));
-    });
+    // A pseudo-angle (monotonic in the angle, no atan2): position on the unit diamond, 0..4.
+    auto angle = [&](const vec3& p) {
+      const float x = glm::dot(p - c, u), y = glm::dot(p - c, w);
+      const float r = std::fabs(x) + std::fabs(y);
+      if (!(r > 0.0f)) return 0.0f;
+      const float q = y / r;
+      return x >= 0.0f ? (y >= 0.0f ? q : 4.0f + q) : 2.0f - q;
+    };
+    std::sort(pts.begin(), pts.end(), [&](const vec3& a, const vec3& b) { return angle(a) < angle(b); });
     std::vector<vec3> out;
     for (const vec3& v : pts)
       if (out.empty() || glm::length(v - out.back()) > 1e-7f * (1.0f + glm::length(v))) out.push_back(v);
@@ -139,6 +162,98 @@ class ConvexCell {
   }
 
   std::vector<std::vector<vec3>> faces_;
+};
+
+/// The cell's surface as triangles, for evaluating many planes of one direction at once. The area of a
+/// triangle below the plane dot(n, x) = d is a piecewise quadratic in d given the heights h0 <= h1 <= h2
+/// of its vertices along n; a clipped face keeps its normal, so by the closed-surface identity the cut
+/// face's area is -sum(dot(n, N_i) a_i(d)) over the faces' unit normals N_i and areas below a_i(d). Each
+/// plane then costs a few flops per surface triangle instead of clipping the polyhedron (ConvexCell::areas
+/// gives the same areas up to rounding).
+class CellSurface {
+ public:
+  /// Fan-triangulates the faces of cell.
+  explicit CellSurface(const ConvexCell& cell) {
+    for (const auto& f : cell.faces())
+      for (size_t i = 2; i < f.size(); ++i) {
+        const vec3 cr = glm::cross(f[i - 1] - f[0], f[i] - f[0]);
+        const float twice = glm::length(cr);
+        if (!(twice > 0.0f)) continue;
+        tris_.push_back({f[0], f[i - 1], f[i], 0.5f * twice, cr / twice});
+        total_ += 0.5f * twice;
+      }
+    for (const auto& f : cell.faces())
+      for (const vec3& v : f) tol_ = std::max(tol_, 1e-6f * (1.0f + glm::length(v)));
+  }
+
+  /// Surface area.
+  float area() const { return total_; }
+
+  /// The cell's extent [lo, hi] along direction n.
+  void extent(const vec3& n, float& lo, float& hi) const {
+    lo = kInf;
+    hi = -kInf;
+    for (const Tri& t : tris_)
+      for (const vec3& v : {t.a, t.b, t.c}) {
+        lo = std::min(lo, glm::dot(n, v));
+        hi = std::max(hi, glm::dot(n, v));
+      }
+  }
+
+  /// Areas of the parts below and above each plane dot(n, x) = d[k] (each including the cut face); a
+  /// plane within rounding of the cell's extent along n does not cut it (one part gets zero area).
+  void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
+    std::fill(below, below + d.size(), 0.0f);
+    float* cut = above;  // the cut face's area accumulates in above[] until the end
+    std::fill(cut, cut + d.size(), 0.0f);
+    float lowest = kInf, highest = -kInf;
+    for (const Tri& t : tris_) {
+      float h[3] = {glm::dot(n, t.a), glm::dot(n, t.b), glm::dot(n, t.c)};
+      if (h[0] > h[1]) std::swap(h[0], h[1]);
+      if (h[1] > h[2]) std::swap(h[1], h[2]);
+      if (h[0] > h[1]) std::swap(h[0], h[1]);
+      lowest = std::min(lowest, h[0]);
+      highest = std::max(highest, h[2]);
+      const float w = glm::dot(n, t.normal);
+      for (size_t k = 0; k < d.size(); ++k) {
+        const float a = t.area * fraction_below(h, d[k]);
+        below[k] += a;
+        cut[k] -= w * a;
+      }
+    }
+    for (size_t k = 0; k < d.size(); ++k) {
+      if (!(d[k] > lowest + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as ConvexCell::part)
+        below[k] = 0.0f;
+        above[k] = total_;
+      } else if (!(d[k] < highest - tol_)) {
+        below[k] = total_;
+        above[k] = 0.0f;
+      } else {
+        const float x = std::max(cut[k], 0.0f);  // cut aliases above: read before writing
+        above[k] = std::max(total_ - below[k], 0.0f) + x;
+        below[k] += x;
+      }
+    }
+  }
+
+ private:
+  struct Tri {
+    vec3 a, b, c;
+    float area;
+    vec3 normal;
+  };
+
+  /// Fraction of a triangle's area with height below d, given its sorted vertex heights.
+  static float fraction_below(const float* h, float d) {
+    if (!(d > h[0])) return 0.0f;
+    if (!(d < h[2])) return 1.0f;
+    if (d < h[1]) return (d - h[0]) * (d - h[0]) / ((h[1] - h[0]) * (h[2] - h[0]));
+    return 1.0f - (h[2] - d) * (h[2] - d) / ((h[2] - h[0]) * (h[2] - h[1]));
+  }
+
+  std::vector<Tri> tris_;
+  float total_ = 0.0f;
+  float tol_ = 0.0f;  ///< rounding band of a vertex's distance from a plane (as ConvexCell::part)
 };
 
 }  // namespace ab

@@ -82,6 +82,42 @@ TEST(BspCandidates, CutBoxByAxisAndDiagonalPlanes) {
   EXPECT_EQ(bsp_directions().size(), 13u);
 }
 
+TEST(BspCell, SurfaceAreasMatchTheClippedCell) {
+  ConvexCell cell = ConvexCell::from_box({{0, 0, 0}, {1, 2, 3}});
+  cell = cell.part(BspPlane{glm::normalize(vec3(1, 1, 1)), 1.0f}, true);
+  cell = cell.part(BspPlane{glm::normalize(vec3(1, -1, 0.5f)), 0.2f}, false);
+  const CellSurface surface(cell);
+  EXPECT_NEAR(surface.area(), cell.area(), 1e-5f);
+  for (const vec3 n : {vec3(1, 0, 0), glm::normalize(vec3(0, 1, 1)), glm::normalize(vec3(1, 1, -1))}) {
+    float lo, hi;
+    surface.extent(n, lo, hi);
+    for (float f : {0.1f, 0.3f, 0.5f, 0.9f}) {
+      const float d[1] = {lo + f * (hi - lo)};
+      float below, above, below_ref, above_ref;
+      surface.areas(n, d, &below, &above);
+      cell.areas(BspPlane{n, d[0]}, below_ref, above_ref);
+      EXPECT_NEAR(below, below_ref, 1e-4f);
+      EXPECT_NEAR(above, above_ref, 1e-4f);
+    }
+  }
+}
+
+TEST(BspCell, APlaneThatDoesNotCutLeavesTheCellWhole) {
+  const ConvexCell box = ConvexCell::from_box({{0, 0, 0}, {1, 1, 1}});
+  const BspPlane diagonal{glm::normalize(vec3(1, 1, 0)), 0.5f};
+  const ConvexCell half = box.part(diagonal, true);
+  // The same plane again: its face is not duplicated and the other side is empty.
+  EXPECT_FLOAT_EQ(half.part(diagonal, true).area(), half.area());
+  EXPECT_EQ(half.part(diagonal, true).faces().size(), half.faces().size());
+  EXPECT_EQ(half.part(diagonal, false).area(), 0.0f);
+  const CellSurface surface(half);
+  const float d[1] = {diagonal.d};
+  float below, above;
+  surface.areas(diagonal.n, d, &below, &above);
+  EXPECT_FLOAT_EQ(below, surface.area());
+  EXPECT_EQ(above, 0.0f);
+}
+
 TEST(Bsp, MatchesBruteOnObliqueGeometryAndRaysInObliquePlanes) {
   const Mesh mesh = oblique_slivers(30, 3);
   std::vector<Ray> rays = oblique_in_plane_rays(1500, 4);
@@ -135,7 +171,11 @@ TEST(Bsp, StatisticsAndThreadIndependence) {
   EXPECT_EQ(0, std::memcmp(h1.data(), h2.data(), h1.size() * sizeof(Hit)));
   EXPECT_EQ(one.nodes, 2 * one.leaves - 1);
   EXPECT_GE(one.references, 20000u);
-  EXPECT_EQ(one.bytes, one.nodes * 8 + (one.nodes - one.leaves) * 16 + one.references * 4);
+  // Stored nodes (empty leaves are flags in their parents), a plane per interior node and the ids (no
+  // leaf-order triangle copies by default).
+  const uint64_t stored = one.extra.at("stored_nodes").get<uint64_t>();
+  EXPECT_EQ(stored, one.nodes - one.empty_leaves);
+  EXPECT_EQ(one.bytes, stored * 8 + (one.nodes - one.leaves) * 16 + one.references * 4);
 }
 
 TEST(Bsp, RejectsBadParameters) {
