@@ -51,7 +51,9 @@ struct BvhBuildResult {
 };
 
 /// Builds a BVH over primitives given by their bounds and centroids. Deterministic: the same tree for
-/// any number of threads. Implemented in bvh.cpp (not a template: the primitive set is not needed).
+/// any number of threads. Implemented in bvh.cpp, bvh_binned.cpp and bvh_sweep.cpp (not a template: the
+/// primitive set is not needed). The binned builder bins the centres of the bounds, which is what both
+/// primitive sets' centroid() returns; the median and sweep builders use `centroids`.
 BvhBuildResult build_bvh(BvhMethod method, const BvhConfig& config, std::span<const AABB> bounds,
                          std::span<const vec3> centroids);
 

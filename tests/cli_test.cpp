@@ -71,8 +71,12 @@ TEST_F(Cli, HelpAndListWork) {
   std::vector<std::string> names;
   for (const auto& a : j["accelerators"]) {
     names.push_back(a["name"]);
-    if (a["name"] == "bvh-sah") EXPECT_EQ(a["params"]["width"], 8);  // parameters with their defaults
-    if (a["name"] == "grid") EXPECT_TRUE(a["params"].contains("lambda"));
+    if (a["name"] == "bvh-sah") {
+      EXPECT_EQ(a["params"]["width"], 8);  // parameters with their defaults
+    }
+    if (a["name"] == "grid") {
+      EXPECT_TRUE(a["params"].contains("lambda"));
+    }
   }
   EXPECT_NE(std::find(names.begin(), names.end(), "brute"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "embree"), names.end());
