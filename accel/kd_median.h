@@ -1,7 +1,7 @@
 // The traditional k-d tree build (Bentley 1975; the spatial-median k-d tree of the ray-tracing lectures):
 // each node splits at the median of its primitives' centres along its longest axis (or the axes in turn),
-// until a leaf holds at most leaf_size primitives, the depth limit is reached, or most primitives would
-// straddle the plane (then splitting only duplicates them). Primitives are tracked by
+// until a leaf holds at most leaf_size primitives, the depth limit is reached, or more than straddle_limit
+// of them would straddle the plane (then splitting mostly duplicates them). Primitives are tracked by
 // their perfect-split bounds inside the node box, and the partition is conservative: a primitive that
 // touches the plane or comes within the insertion margin of it goes to both children.
 #pragma once
@@ -20,6 +20,7 @@ struct KdMedianSettings {
   size_t leaf_size = 4;        ///< a node with at most this many primitives is a leaf
   int max_depth = 0;           ///< resolved depth limit (> 0)
   bool cycle_axes = false;     ///< false: longest axis of the node box; true: x, y, z in turn
+  double straddle_limit = 0.5; ///< a node whose split would put more than this share of it on both sides is a leaf
   size_t parallel_min = 16384; ///< nodes at least this large build their children in parallel
 };
 
@@ -57,7 +58,7 @@ class KdMedianBuilder {
     lbox.hi[axis] = split;
     rbox.lo[axis] = split;
     partition(refs, axis, split, insertion_margin(box), lbox, rbox, left, right);
-    if (left.size() + right.size() > n + n * 3 / 4) {  // most primitives straddle: splitting no longer pays
+    if (double(left.size() + right.size()) > double(n) * (1.0 + s_.straddle_limit)) {  // splitting no longer pays
       make_leaf(refs, out);
       return;
     }

@@ -34,9 +34,11 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
     } else {
       median_.leaf_size = size_t(params.get_int("leaf_size", 4, 1, 1 << 20));
       median_.cycle_axes = params.get_choice("axis", "longest", {"longest", "cycle"}) == "cycle";
+      median_.straddle_limit = params.get_float("straddle_limit", 0.5, 0.0, 1.0);
     }
     max_depth_ = int(params.get_int("max_depth", 0, 0, 100));
-    leaf_copies_ = params.get_bool("leaf_copies", true);
+    // Copies pay for the SAH tree (under 2 references per triangle); the median tree stores several times more.
+    leaf_copies_ = params.get_bool("leaf_copies", M == KdMethod::kSah);
     config_ = params.effective();
   }
 
