@@ -266,9 +266,8 @@ class BspBuilder {
     return best;
   }
 
-  /// Candidate planes of direction dir. A node of at most `bins` primitives tries the planes just outside
-  /// each primitive's extent (two margins, so the primitive is classified on one side only), like the events
-  /// of a k-d sweep; a larger node the bin boundaries of the extents (Wald 2007's binning, a primitive
+  /// Candidate planes of direction dir. A node of at most `bins` primitives tries the planes at the ends of
+  /// each primitive's extent (the primitive is classified on one side only), like the events of a k-d sweep; a larger node the bin boundaries of the extents (Wald 2007's binning, a primitive
   /// counted on every side its extent reaches) and two planes just outside all extents. A plane with an
   /// empty side must cut off at least 1/bins of the cell's extent, or each node would shave off another
   /// sliver (its primitives clipped a little tighter) down to the depth limit.
@@ -303,18 +302,19 @@ class BspBuilder {
     }
   }
 
-  /// Planes two margins below each extent's start and above each extent's end, with exact counts.
+  /// Planes at each extent's start and end (that primitive on one side only), with exact counts.
   void exact_candidates(const std::vector<float>& lo, const std::vector<float>& hi, std::vector<float>& d,
                         std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
     for (size_t k = 0; k < lo.size(); ++k) {
-      d.push_back(lo[k] - 2.0f * s_.margin);
-      d.push_back(hi[k] + 2.0f * s_.margin);
+      d.push_back(lo[k]);  // primitive k above only (side_bits)
+      d.push_back(hi[k]);  // primitive k below only
     }
     for (const float x : d) {
       uint32_t l = 0, r = 0;
       for (size_t k = 0; k < lo.size(); ++k) {  // the classification of side()
-        l += lo[k] - x <= s_.margin;
-        r += hi[k] - x >= -s_.margin;
+        const int bits = side_bits(lo[k] - x, hi[k] - x);
+        l += bits & 1;
+        r += bits >> 1;
       }
       nl.push_back(l);
       nr.push_back(r);
@@ -348,11 +348,19 @@ class BspBuilder {
     nr.push_back(0);
   }
 
-  /// Side of primitive k: bit 0 below, bit 1 above (both when its clipped part comes within the margin).
+  /// Side of a primitive whose clipped part spans signed distances [lo, hi] from a plane: bit 0 below, bit 1
+  /// above. A part within half the margin of the plane on the other side stays on one side (as Wald and
+  /// Havran place touching primitives): the traversal's band (margin plus rounding) covers it.
+  int side_bits(float lo, float hi) const {
+    if (hi <= 0.5f * s_.margin) return 1;
+    if (lo >= -0.5f * s_.margin) return 2;
+    return 3;
+  }
+  /// Side of primitive k (side_bits).
   int side(const NodePrims& np, size_t k, const BspPlane& plane) const {
     float lo, hi;
     range(np, k, plane.n, plane.d, lo, hi);
-    return (lo <= s_.margin ? 1 : 0) | (hi >= -s_.margin ? 2 : 0);
+    return side_bits(lo, hi);
   }
 
   void partition(const NodePrims& np, const BspPlane& plane, std::vector<uint32_t>& left,
