@@ -389,7 +389,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
     s_.bins = int(params.get_int("bins", 16, 2, 256));
     s_.autopartition = int(params.get_int("autopartition", 8, 0, 1024));
     max_depth_ = int(params.get_int("max_depth", 0, 0, 100));
-    leaf_copies_ = params.get_bool("leaf_copies", false);  // ~15 references per triangle on slivers
+    leaf_copies_ = read_leaf_copies(params);
     config_ = params.effective();
   }
 
@@ -505,6 +505,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
                unbounded_.size() * 4;
     st.extra["depth_limit"] = depth_limit;
     st.extra["unbounded_primitives"] = unbounded_.size();
+    st.extra["leaf_copies"] = leaves_.copied();
     size_t axis_planes = 0;
     for (const BspPlane& p : planes_) axis_planes += !is_oblique(p);
     st.extra["axis_aligned_planes"] = axis_planes;
@@ -531,7 +532,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   std::shared_ptr<const P> prims_;
   BspSettings s_;
   int max_depth_ = 0;
-  bool leaf_copies_ = false;  ///< copy triangles into leaf order (LeafRefs)
+  LeafCopies leaf_copies_ = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   float margin_ = 0.0f;
   nlohmann::json config_;
   AABB box_;

@@ -5,6 +5,7 @@
 
 #include "accel/error.h"
 #include "accel/geometry.h"
+#include "accel/params.h"
 #include "accel/primitives.h"
 #include "accel/stats.h"
 #include "accel/triangle.h"
@@ -197,6 +198,18 @@ bool occluded_id_list(const P& prims, const uint32_t* ids, uint32_t count, const
   return false;
 }
 
+/// When the leaves copy their triangles (parameter leaf_copies: on, off, or auto = when the leaves hold at most
+/// kAutoCopyReferences references per triangle, so the copies cost at most about 108 bytes per triangle).
+enum class LeafCopies { kOff, kOn, kAuto };
+/// References per triangle up to which leaf_copies=auto copies.
+inline constexpr double kAutoCopyReferences = 3.0;
+
+/// Reads the leaf_copies parameter (on, off or auto).
+inline LeafCopies read_leaf_copies(Params& params) {
+  const std::string v = params.get_choice("leaf_copies", "auto", {"auto", "on", "off"});
+  return v == "on" ? LeafCopies::kOn : v == "off" ? LeafCopies::kOff : LeafCopies::kAuto;
+}
+
 /// The leaves' primitive references in leaf order: the original ids and, for triangle sets when asked, a
 /// copy of each referenced triangle in the same order, so that a leaf reads its triangles from one
 /// contiguous run (as the BVH's leaves do) instead of gathering them by id. A triangle referenced by several
@@ -208,12 +221,13 @@ class LeafRefs {
   /// True when the primitive set can be copied into leaf order.
   static constexpr bool kCanCopy = std::is_same_v<P, TrianglePrims>;
 
-  /// Takes the leaf-ordered ids and, when `copy` is set, copies the triangles they name.
-  void assign(const P& prims, std::vector<uint32_t> ids, bool copy) {
+  /// Takes the leaf-ordered ids and copies the triangles they name as `mode` says.
+  void assign(const P& prims, std::vector<uint32_t> ids, LeafCopies mode) {
     ids_ = std::move(ids);
     tris_.clear();
     if constexpr (kCanCopy) {
-      if (copy) {
+      const bool few = double(ids_.size()) <= kAutoCopyReferences * double(prims.size());
+      if (mode == LeafCopies::kOn || (mode == LeafCopies::kAuto && few)) {
         tris_.resize(ids_.size());
         for (size_t k = 0; k < ids_.size(); ++k) tris_[k] = prims.triangle(ids_[k]);
       }
@@ -221,6 +235,8 @@ class LeafRefs {
   }
   /// The leaf-ordered ids.
   const std::vector<uint32_t>& ids() const { return ids_; }
+  /// True when the triangles were copied.
+  bool copied() const { return !tris_.empty(); }
   /// Memory of the ids and copies.
   size_t bytes() const { return ids_.size() * sizeof(uint32_t) + tris_.size() * sizeof(Triangle); }
 

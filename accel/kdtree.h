@@ -37,8 +37,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
       median_.straddle_limit = params.get_float("straddle_limit", 0.5, 0.0, 1.0);
     }
     max_depth_ = int(params.get_int("max_depth", 0, 0, 100));
-    // Copies pay for the SAH tree (under 2 references per triangle); the median tree stores several times more.
-    leaf_copies_ = params.get_bool("leaf_copies", M == KdMethod::kSah);
+    leaf_copies_ = read_leaf_copies(params);
     config_ = params.effective();
   }
 
@@ -165,6 +164,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
     st.bytes = nodes_.size() * sizeof(KdNode) + leaves_.bytes() + unbounded_.size() * sizeof(uint32_t);
     st.extra["depth_limit"] = depth_limit;
     st.extra["unbounded_primitives"] = unbounded_.size();
+    st.extra["leaf_copies"] = leaves_.copied();
     if (nodes_.empty()) return;
     const double root_area = box_.area();
     struct Item {
@@ -202,7 +202,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   KdSahSettings sah_;
   KdMedianSettings median_;
   int max_depth_ = 0;
-  bool leaf_copies_ = true;  ///< copy triangles into leaf order (LeafRefs)
+  LeafCopies leaf_copies_ = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   nlohmann::json config_;
   AABB box_;
   AABB root_box_;       ///< box_ grown by margin_ (the traversal's first clip)

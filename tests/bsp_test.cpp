@@ -171,11 +171,14 @@ TEST(Bsp, StatisticsAndThreadIndependence) {
   EXPECT_EQ(0, std::memcmp(h1.data(), h2.data(), h1.size() * sizeof(Hit)));
   EXPECT_EQ(one.nodes, 2 * one.leaves - 1);
   EXPECT_GE(one.references, 20000u);
-  // Stored nodes (empty leaves are flags in their parents), a plane per interior node and the ids (no
-  // leaf-order triangle copies by default).
+  // Stored nodes (empty leaves are flags in their parents), a plane per interior node, the ids and, with
+  // at most 3 references per triangle (leaf_copies=auto), leaf-order triangle copies.
   const uint64_t stored = one.extra.at("stored_nodes").get<uint64_t>();
   EXPECT_EQ(stored, one.nodes - one.empty_leaves);
-  EXPECT_EQ(one.bytes, stored * 8 + (one.nodes - one.leaves) * 16 + one.references * 4);
+  const bool copies = one.extra.at("leaf_copies").get<bool>();
+  EXPECT_EQ(copies, one.references <= 3 * one.primitives);
+  EXPECT_EQ(one.bytes,
+            stored * 8 + (one.nodes - one.leaves) * 16 + one.references * (4 + (copies ? sizeof(Triangle) : 0)));
 }
 
 TEST(Bsp, RejectsBadParameters) {

@@ -222,7 +222,7 @@ TEST(KdTree, LeafCopiesOnOrOffGiveTheSameHitsAsBrute) {
   for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
   const std::vector<Ray> rays = adversarial_rays(mesh, 2000, 22);
   for (const char* name : {"kdtree-sah", "kdtree-median", "bsp"})
-    for (const char* copies : {"0", "1"})
+    for (const char* copies : {"off", "on"})
       EXPECT_EQ(count_differences(name, mesh, rays, {{"leaf_copies", copies}}), 0u) << name << " " << copies;
 }
 
@@ -264,7 +264,9 @@ TEST(KdTree, StatisticsDescribeABinaryTree) {
     // Stored nodes (empty leaves are flags in their parents), ids and leaf-order triangle copies.
     const uint64_t stored = s.extra.at("stored_nodes").get<uint64_t>();
     EXPECT_EQ(stored, s.nodes - s.empty_leaves) << name;
-    const bool copies = std::string(name) == "kdtree-sah";  // the median tree keeps ids only by default
+    // leaf_copies=auto: copies when there are at most 3 references per triangle.
+    const bool copies = s.extra.at("leaf_copies").get<bool>();
+    EXPECT_EQ(copies, s.references <= 3 * s.primitives) << name;
     EXPECT_EQ(s.bytes, stored * 8 + s.references * (4 + (copies ? sizeof(Triangle) : 0))) << name;
     EXPECT_LE(s.max_depth, uint32_t(auto_kd_depth(3000)));
   }
