@@ -73,6 +73,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   Octree(std::shared_ptr<const P> prims, Params& params) : prims_(std::move(prims)) {
     leaf_size_ = size_t(params.get_int("leaf_size", 8, 1, 1 << 20));
     max_depth_ = int(params.get_int("max_depth", 10, 0, 20));
+    leaf_copies_ = read_leaf_copies(params);
     config_ = params.effective();
   }
 
@@ -82,10 +83,10 @@ class Octree final : public AcceleratorBase<Octree<P>> {
 
   /// Closest hit, children front to back.
   template <bool kCount>
-  void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
     intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
     auto leaf = [&](const OctNode& n) {
-      intersect_id_list<kCount>(*prims_, &ids_[n.first()], n.count(), ray, best, inst, c);
+      leaves_.template intersect<kCount>(*prims_, n.first(), n.count(), ray, best, inst, c);
       return false;
     };
     traverse<kCount>(ray, c, leaf, [&] { return best.t; });
@@ -95,7 +96,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
     if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
-    auto leaf = [&](const OctNode& n) { return occluded_id_list<kCount>(*prims_, &ids_[n.first()], n.count(), ray, c); };
+    auto leaf = [&](const OctNode& n) { return leaves_.template occluded<kCount>(*prims_, n.first(), n.count(), ray, c); };
     return traverse<kCount>(ray, c, leaf, [] { return kInf; });
   }
 
@@ -108,7 +109,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
     out.nodes.push_back(OctNode::leaf(0, 0));
     if (!ids.empty()) build_node(std::move(ids), box_, 0, 0, out);
     nodes_ = std::move(out.nodes);
-    ids_ = std::move(out.prims);
+    leaves_.assign(*prims_, std::move(out.prims), leaf_copies_);
     fill_stats();
   }
 
@@ -252,7 +253,8 @@ class Octree final : public AcceleratorBase<Octree<P>> {
     st = BuildStats{};
     st.primitives = prims_->size();
     st.nodes = nodes_.size();
-    st.bytes = nodes_.size() * sizeof(OctNode) + ids_.size() * sizeof(uint32_t) + unbounded_.size() * 4;
+    st.bytes = nodes_.size() * sizeof(OctNode) + leaves_.bytes() + unbounded_.size() * 4;
+    st.extra["leaf_copies"] = leaves_.copied();
     st.extra["unbounded_primitives"] = unbounded_.size();
     struct Item {
       uint32_t node, depth;
@@ -284,7 +286,8 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   nlohmann::json config_;
   AABB box_;
   std::vector<OctNode> nodes_;
-  std::vector<uint32_t> ids_;
+  LeafCopies leaf_copies_ = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
+  LeafRefs<P> leaves_;
   std::vector<uint32_t> unbounded_;
 };
 

@@ -221,7 +221,7 @@ TEST(KdTree, LeafCopiesOnOrOffGiveTheSameHitsAsBrute) {
   mesh.vertices.insert(mesh.vertices.end(), soup.vertices.begin(), soup.vertices.end());
   for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
   const std::vector<Ray> rays = adversarial_rays(mesh, 2000, 22);
-  for (const char* name : {"kdtree-sah", "kdtree-median", "bsp"})
+  for (const char* name : {"kdtree-sah", "kdtree-median", "bsp", "octree"})
     for (const char* copies : {"off", "on"})
       EXPECT_EQ(count_differences(name, mesh, rays, {{"leaf_copies", copies}}), 0u) << name << " " << copies;
 }
