@@ -183,7 +183,7 @@ BvhConfig read_bvh_config(BvhMethod method, Params& params) {
     c.max_leaf_size = int(params.get_int("leaf_size", 4, 1, 1 << 20));
   } else {
     c.max_leaf_size = int(params.get_int("max_leaf_size", 8, 1, 1 << 20));
-    if (method == BvhMethod::kBinnedSah) c.bins = int(params.get_int("bins", 16, 2, 256));
+    if (method == BvhMethod::kBinnedSah) c.bins = int(params.get_int("bins", 32, 2, 256));
     c.costs.traversal = float(params.get_float("traversal_cost", 1.0, 0.0, 1e6));
     c.costs.intersection = float(params.get_float("intersection_cost", 1.0, 1e-6, 1e6));
   }

@@ -37,7 +37,7 @@ enum class BvhMethod {
 struct BvhConfig {
   int max_leaf_size = 4;             ///< median: leaf size; SAH: a node above this size is always split
   int max_depth = 64;                ///< a node at this depth becomes a leaf
-  int bins = 16;                     ///< binned SAH: bins per axis
+  int bins = 32;                     ///< binned SAH: bins per axis
   SahCosts costs;                    ///< SAH traversal and intersection costs
   size_t parallel_threshold = 4096;  ///< subtrees at least this large build their children in parallel
 };
