@@ -20,7 +20,7 @@ struct KdMedianSettings {
   size_t leaf_size = 4;        ///< a node with at most this many primitives is a leaf
   int max_depth = 0;           ///< resolved depth limit (> 0)
   bool cycle_axes = false;     ///< false: longest axis of the node box; true: x, y, z in turn
-  double straddle_limit = 0.5; ///< a node whose split would put more than this share of it on both sides is a leaf
+  double straddle_limit = 0.75; ///< a node whose split would put more than this share of it on both sides is a leaf
   size_t parallel_min = 16384; ///< nodes at least this large build their children in parallel
 };
 

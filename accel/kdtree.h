@@ -34,7 +34,7 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
     } else {
       median_.leaf_size = size_t(params.get_int("leaf_size", 4, 1, 1 << 20));
       median_.cycle_axes = params.get_choice("axis", "longest", {"longest", "cycle"}) == "cycle";
-      median_.straddle_limit = params.get_float("straddle_limit", 0.5, 0.0, 1.0);
+      median_.straddle_limit = params.get_float("straddle_limit", 0.75, 0.0, 1.0);
     }
     max_depth_ = int(params.get_int("max_depth", 0, 0, 100));
     leaf_copies_ = read_leaf_copies(params);
