@@ -62,6 +62,13 @@ inline T l1_norm(const Vec3T<T>& a) {
   return lane_abs(a.x) + lane_abs(a.y) + lane_abs(a.z);
 }
 
+/// The kernel's bound on the rounding of its denominator dot(dir, e1 x e2): relative kCoplanarEps of the
+/// L1 product of |dir|, |e1|, |e2|. A ray whose |den| does not exceed it counts as lying in the plane.
+template <class T>
+inline T parallel_bound(const Vec3T<T>& dir, const Vec3T<T>& e1, const Vec3T<T>& e2) {
+  return l1_norm(dir) * l1_norm(e1) * l1_norm(e2) * T(kCoplanarEps);
+}
+
 /// Moller and Trumbore 1997, "Fast, minimum storage ray-triangle intersection", written with the
 /// geometric normal n = e1 x e2 (as Embree does) so that a zero-area triangle, whose n is exactly the
 /// zero vector, has a zero denominator and never hits; nor does a ray lying in the triangle's plane.
@@ -82,8 +89,7 @@ template <class T>
   // of |dir|, |e1|, |e2|), or the ray counts as parallel. The same rule for every structure keeps hits
   // identical; such rays graze the plane within about 1e-5 radians (Embree's differ: verify calls them
   // graze cases). Also rejects NaN.
-  const T scale = l1_norm(dir) * l1_norm(e1) * l1_norm(e2);
-  auto ok = lane_abs(den) > scale * T(kCoplanarEps);
+  auto ok = lane_abs(den) > parallel_bound(dir, e1, e2);
   if (lane_none(ok)) return ok;
   const T inv = T(1.0f) / den;
   const Vec3T<T> to_origin = org - v0;
@@ -100,6 +106,13 @@ template <class T>
 
 /// A glm vector as kernel coordinates.
 inline Vec3T<float> to_lanes(const vec3& a) { return {a.x, a.y, a.z}; }
+
+/// True when the kernel treats the ray as lying in the triangle's plane (it never reports a hit then).
+inline bool kernel_calls_parallel(const Ray& ray, const Triangle& tri) {
+  const Vec3T<float> e1 = to_lanes(tri.v1) - to_lanes(tri.v0), e2 = to_lanes(tri.v2) - to_lanes(tri.v0);
+  const Vec3T<float> dir = to_lanes(ray.dir);
+  return !(lane_abs(dot(dir, cross(e1, e2))) > parallel_bound(dir, e1, e2));
+}
 
 /// The kernel for one triangle. Returns true and fills out on a hit.
 inline bool intersect_triangle(const Ray& ray, const Triangle& tri, TriangleHit& out) {

@@ -28,8 +28,8 @@ IdenticalResult compare_identical(std::span<const Hit> expected, std::span<const
 struct Agreement {
   uint64_t agree = 0;        ///< same (inst, prim) and t within a relative 1e-4, or both miss
   uint64_t tie = 0;          ///< different primitives hit at the same t (duplicates, shared edges, coplanar)
-  uint64_t edge = 0;         ///< a hit lies on or within 1e-4 (barycentric) of an edge or vertex of its triangle
-  uint64_t graze = 0;        ///< a hit triangle is nearly parallel to the ray (|cos| < 1e-3)
+  uint64_t edge = 0;         ///< a hit lies within 1e-4 (barycentric) or 1e-5 of the coordinates' scale (distance) of an edge
+  uint64_t graze = 0;        ///< a hit triangle is nearly parallel to the ray (|cos| < 1e-3, or the kernel calls it parallel)
   uint64_t limit = 0;        ///< a hit t is within rounding of tmin or tmax
   uint64_t unexplained = 0;  ///< anything else: a real disagreement
   std::vector<uint64_t> unexplained_rays;  ///< up to 10 ray indices

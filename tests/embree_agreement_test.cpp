@@ -39,6 +39,27 @@ TEST(EmbreeAgreement, BruteAgreesWithEmbreeOnEveryGeneratorAndRayKind) {
   }
 }
 
+TEST(EmbreeAgreement, SliverHitsWithinRoundingOfALongEdgeAreEdgeCases) {
+  // A sliver of aspect 3000 (length 0.3, height 1e-4): a hit 2e-8 from its long edge has a barycentric
+  // weight of 2e-4, above the barycentric tolerance but well within float rounding at coordinates near 1.
+  const Triangle sliver{{0.5f, 0.5f, 0.5f}, {0.8f, 0.5f, 0.5f}, {0.5f, 0.5001f, 0.5f}};
+  const Triangle plain{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const auto triangle_of = [&](const Hit& h) { return h.prim == 0 ? sliver : plain; };
+  Ray ray;
+  ray.org = {0.6f, 0.5f, 0.0f};
+  ray.dir = {0, 0, 1};
+  const Hit miss;
+  const Hit near_long_edge{0.5f, 0, 0, 0.3f, 2e-4f};  // weight of v2 (the apex above the long edge)
+  const Hit inside_sliver{0.5f, 0, 0, 0.3f, 0.5f};
+  const Hit inside_plain{0.5f, 1, 0, 0.3f, 0.3f};
+  const std::vector<Ray> rays(3, ray);
+  const std::vector<Hit> ours{miss, miss, miss}, theirs{near_long_edge, inside_sliver, inside_plain};
+  const Agreement a = classify_agreement(rays, ours, theirs, triangle_of);
+  EXPECT_EQ(a.edge, 1u);
+  EXPECT_EQ(a.unexplained, 2u);
+  EXPECT_EQ(a.unexplained_rays, (std::vector<size_t>{1, 2}));
+}
+
 TEST(EmbreeAdapter, QualityParameterIsCheckedAndRecorded) {
   const Target target = mesh_target(std::make_shared<const Mesh>(generate_mesh("soup", 500, 1, Params{})), "soup");
   Params p;
