@@ -12,7 +12,8 @@
 
 namespace ab {
 
-/// Four floats in one SSE register, with the arithmetic the kernel uses.
+/// Four floats in one SSE register, with the arithmetic the kernel uses (SSE2 only: comparisons are ordered,
+/// false on NaN, like the scalar ones).
 struct Lanes4 {
   __m128 v;
   Lanes4() = default;
@@ -28,9 +29,9 @@ inline Lanes4 operator-(Lanes4 a, Lanes4 b) { return Lanes4(_mm_sub_ps(a.v, b.v)
 inline Lanes4 operator*(Lanes4 a, Lanes4 b) { return Lanes4(_mm_mul_ps(a.v, b.v)); }
 inline Lanes4 operator/(Lanes4 a, Lanes4 b) { return Lanes4(_mm_div_ps(a.v, b.v)); }
 inline Lanes4 operator-(Lanes4 a) { return Lanes4(_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))); }
-inline Mask4 operator>(Lanes4 a, Lanes4 b) { return {_mm_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
-inline Mask4 operator>=(Lanes4 a, Lanes4 b) { return {_mm_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
-inline Mask4 operator<=(Lanes4 a, Lanes4 b) { return {_mm_cmp_ps(a.v, b.v, _CMP_LE_OQ)}; }
+inline Mask4 operator>(Lanes4 a, Lanes4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline Mask4 operator>=(Lanes4 a, Lanes4 b) { return {_mm_cmpge_ps(a.v, b.v)}; }
+inline Mask4 operator<=(Lanes4 a, Lanes4 b) { return {_mm_cmple_ps(a.v, b.v)}; }
 inline Lanes4 lane_abs(Lanes4 a) { return Lanes4(_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)); }
 inline bool lane_none(Mask4 m) { return _mm_movemask_ps(m.m) == 0; }
 inline Mask4 lane_and(Mask4 a, Mask4 b) { return {_mm_and_ps(a.m, b.m)}; }
