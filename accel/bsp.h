@@ -379,7 +379,9 @@ class BspBuilder {
 
 /// BSP tree (registry name bsp).
 template <class P>
-class BspTree final : public AcceleratorBase<BspTree<P>> {
+class BspTree final : public SpatialTreeQueries<BspTree<P>> {
+  friend class SpatialTreeQueries<BspTree<P>>;
+
  public:
   /// Reads the configuration from params.
   BspTree(std::shared_ptr<const P> prims, Params& params) : prims_(std::move(prims)) {
@@ -396,26 +398,6 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
   std::string name() const override { return "bsp"; }
   nlohmann::json config() const override { return config_; }
   AABB bounds() const override { return prims_->bounds(); }
-
-  /// Closest hit, front to back.
-  template <bool kCount>
-  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    if (!unbounded_.empty())
-      intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
-    auto leaf = [&](const BspNode& n) {
-      leaves_.template intersect<kCount>(*prims_, n.first(), n.count(), ray, best, inst, c);
-      return false;
-    };
-    traverse<kCount>(ray, c, leaf, [&] { return best.t; });
-  }
-
-  /// Any hit.
-  template <bool kCount>
-  bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
-    auto leaf = [&](const BspNode& n) { return leaves_.template occluded<kCount>(*prims_, n.first(), n.count(), ray, c); };
-    return traverse<kCount>(ray, c, leaf, [] { return kInf; });
-  }
 
  protected:
   void do_build() override {
@@ -453,7 +435,7 @@ class BspTree final : public AcceleratorBase<BspTree<P>> {
       if constexpr (kCount) ++c.nodes;
       if (n.is_leaf()) {
         if constexpr (kCount) ++c.leaves;
-        if (n.count() && leaf(n)) return true;
+        if (n.count() && leaf(n.first(), n.count())) return true;
       } else if (step(n, cur, ray, abs_org, stack, sp)) {
         continue;
       }

@@ -3,6 +3,7 @@
 // insertion helpers shared by the k-d builders.
 #pragma once
 
+#include "accel/accelerator.h"
 #include "accel/error.h"
 #include "accel/geometry.h"
 #include "accel/params.h"
@@ -281,5 +282,39 @@ class LeafRefs {
 
 /// Default depth limit of the k-d builders: 8 + 1.3 log2 N (Havran 2000; pbrt).
 inline int auto_kd_depth(size_t n) { return int(std::lround(8.0 + 1.3 * std::log2(double(std::max<size_t>(n, 1))))); }
+
+/// The closest-hit and any-hit queries of a spatial tree D (k-d trees, octree, BSP), written once: the
+/// unbounded primitives by list, then D's front-to-back traverse<kCount>(ray, c, leaf(first, count),
+/// best_t()) over the leaves' lists (LeafRefs). D declares this class a friend for prims_, unbounded_,
+/// leaves_ and traverse.
+template <class D>
+class SpatialTreeQueries : public AcceleratorBase<D> {
+ public:
+  /// Closest hit, front to back; a leaf's cells are pruned by best.t.
+  template <bool kCount>
+  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+    const D& d = static_cast<const D&>(*this);
+    if (!d.unbounded_.empty())
+      intersect_id_list<kCount>(*d.prims_, d.unbounded_.data(), uint32_t(d.unbounded_.size()), ray, best, inst, c);
+    d.template traverse<kCount>(
+        ray, c,
+        [&](uint32_t first, uint32_t count) {
+          d.leaves_.template intersect<kCount>(*d.prims_, first, count, ray, best, inst, c);
+          return false;
+        },
+        [&] { return best.t; });
+  }
+
+  /// Any hit: the same walk, stopping at the first primitive that blocks the ray.
+  template <bool kCount>
+  bool occluded_ray(const Ray& ray, RayCounters& c) const {
+    const D& d = static_cast<const D&>(*this);
+    if (occluded_id_list<kCount>(*d.prims_, d.unbounded_.data(), uint32_t(d.unbounded_.size()), ray, c)) return true;
+    return d.template traverse<kCount>(
+        ray, c,
+        [&](uint32_t first, uint32_t count) { return d.leaves_.template occluded<kCount>(*d.prims_, first, count, ray, c); },
+        [] { return kInf; });
+  }
+};
 
 }  // namespace ab

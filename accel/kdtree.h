@@ -23,7 +23,9 @@ enum class KdMethod { kMedian, kSah };
 /// plane step (split_plane.h) per interior node, leaves pruned only when their entry lies strictly
 /// beyond the best hit so far.
 template <class P, KdMethod M>
-class KdTree final : public AcceleratorBase<KdTree<P, M>> {
+class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
+  friend class SpatialTreeQueries<KdTree<P, M>>;
+
  public:
   /// Reads the configuration from params (see config() for the fields).
   KdTree(std::shared_ptr<const P> prims, Params& params) : prims_(std::move(prims)) {
@@ -44,30 +46,6 @@ class KdTree final : public AcceleratorBase<KdTree<P, M>> {
   std::string name() const override { return M == KdMethod::kSah ? "kdtree-sah" : "kdtree-median"; }
   nlohmann::json config() const override { return config_; }
   AABB bounds() const override { return prims_->bounds(); }
-
-  /// Closest hit: front-to-back traversal with a stack of far children.
-  template <bool kCount>
-  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    if (!unbounded_.empty())
-      intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
-    traverse<kCount>(
-        ray, c,
-        [&](uint32_t first, uint32_t count) {
-          leaves_.template intersect<kCount>(*prims_, first, count, ray, best, inst, c);
-          return false;
-        },
-        [&] { return best.t; });
-  }
-
-  /// Any hit: the same traversal, stopping at the first primitive that blocks the ray.
-  template <bool kCount>
-  bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
-    return traverse<kCount>(
-        ray, c,
-        [&](uint32_t first, uint32_t count) { return leaves_.template occluded<kCount>(*prims_, first, count, ray, c); },
-        [] { return kInf; });
-  }
 
  protected:
   void do_build() override {

@@ -67,7 +67,9 @@ inline AABB octant_box(const AABB& b, int c) {
 
 /// Adaptive octree (registry name octree).
 template <class P>
-class Octree final : public AcceleratorBase<Octree<P>> {
+class Octree final : public SpatialTreeQueries<Octree<P>> {
+  friend class SpatialTreeQueries<Octree<P>>;
+
  public:
   /// Reads leaf_size and max_depth from params.
   Octree(std::shared_ptr<const P> prims, Params& params) : prims_(std::move(prims)) {
@@ -80,25 +82,6 @@ class Octree final : public AcceleratorBase<Octree<P>> {
   std::string name() const override { return "octree"; }
   nlohmann::json config() const override { return config_; }
   AABB bounds() const override { return prims_->bounds(); }
-
-  /// Closest hit, children front to back.
-  template <bool kCount>
-  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
-    auto leaf = [&](const OctNode& n) {
-      leaves_.template intersect<kCount>(*prims_, n.first(), n.count(), ray, best, inst, c);
-      return false;
-    };
-    traverse<kCount>(ray, c, leaf, [&] { return best.t; });
-  }
-
-  /// Any hit.
-  template <bool kCount>
-  bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    if (occluded_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, c)) return true;
-    auto leaf = [&](const OctNode& n) { return leaves_.template occluded<kCount>(*prims_, n.first(), n.count(), ray, c); };
-    return traverse<kCount>(ray, c, leaf, [] { return kInf; });
-  }
 
  protected:
   void do_build() override {
@@ -141,7 +124,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
     return out;
   }
 
-  /// Shared traversal; leaf(n) returns true to stop (any hit); best_t() is the pruning distance.
+  /// Shared traversal; leaf(first, count) returns true to stop (any hit); best_t() is the pruning distance.
   template <bool kCount, class Leaf, class BestT>
   bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
     float t0 = ray.tmin, t1 = ray.tmax;
@@ -155,7 +138,7 @@ class Octree final : public AcceleratorBase<Octree<P>> {
       const OctNode& n = nodes_[cur.node];
       if (n.is_leaf()) {
         if constexpr (kCount) ++c.leaves;
-        if (n.count() && leaf(n)) return true;
+        if (n.count() && leaf(n.first(), n.count())) return true;
       } else if (cur.level == 3) {
         cur = {n.first() + uint32_t(cur.octant), 0, 0, cur.t0, cur.t1, cur.box};
         if constexpr (kCount) ++c.nodes;
