@@ -1,6 +1,6 @@
 #include "datasets/atomic_file.h"
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 
 #include <cstdio>
 #include <filesystem>

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "datasets/mesh_builder.h"
 #include "datasets/random.h"
 

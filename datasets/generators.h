@@ -2,8 +2,8 @@
 // (and the same bytes when written).
 #pragma once
 
-#include "accel/mesh.h"
-#include "accel/params.h"
+#include "accel/core/mesh.h"
+#include "accel/core/params.h"
 
 #include <cstdint>
 #include <functional>

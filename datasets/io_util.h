@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 
 namespace ab {
 

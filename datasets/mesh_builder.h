@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <utility>
 
-#include "accel/mesh.h"
+#include "accel/core/mesh.h"
 
 namespace ab {
 

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <string>
 
-#include "accel/error.h"
-#include "accel/mesh.h"
+#include "accel/core/error.h"
+#include "accel/core/mesh.h"
 
 namespace ab {
 

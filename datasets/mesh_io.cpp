@@ -13,7 +13,7 @@
 #include <mutex>
 #include <sstream>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "datasets/atomic_file.h"
 #include "datasets/io_util.h"
 #include "datasets/mesh_checks.h"

@@ -2,7 +2,7 @@
 // contract's id rule (face order kept, polygons fan-triangulated, every face kept).
 #pragma once
 
-#include "accel/mesh.h"
+#include "accel/core/mesh.h"
 
 #include <string>
 

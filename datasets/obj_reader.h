@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "accel/mesh.h"
+#include "accel/core/mesh.h"
 
 namespace ab {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <functional>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "datasets/random.h"
 
 namespace ab {

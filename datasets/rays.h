@@ -1,7 +1,7 @@
 // Ray sets: deterministic workloads made from a mesh (or anything that can be traced).
 #pragma once
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 #include <cstdint>
 #include <functional>

@@ -5,7 +5,7 @@
 #include <ostream>
 #include <string>
 
-#include "accel/mesh.h"
+#include "accel/core/mesh.h"
 
 namespace ab {
 

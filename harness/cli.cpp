@@ -1,7 +1,7 @@
 #include "harness/cli.h"
 
-#include "accel/error.h"
-#include "accel/registry.h"
+#include "accel/core/error.h"
+#include "accel/core/registry.h"
 
 #include <algorithm>
 #include <iostream>

@@ -1,5 +1,5 @@
 // `accelbench list [--json]`: accelerators, mesh generators and ray kinds.
-#include "accel/registry.h"
+#include "accel/core/registry.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/cli.h"

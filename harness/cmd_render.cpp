@@ -9,8 +9,8 @@
 #include <iostream>
 #include <memory>
 
-#include "accel/error.h"
-#include "accel/registry.h"
+#include "accel/core/error.h"
+#include "accel/core/registry.h"
 #include "harness/cli.h"
 #include "harness/options.h"
 #include "harness/target.h"

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "harness/cli.h"
 #include "harness/report.h"
 #include "harness/run.h"

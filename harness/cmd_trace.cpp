@@ -1,6 +1,6 @@
 // `accelbench trace (--mesh F | --scene F) --accel NAME --rays FILE.rays -o FILE.hits [--threads T]
 //  [--stats FILE.json] [--param k=v ...] [--accel-top NAME] [--accel-bottom NAME]`
-#include "accel/trace.h"
+#include "accel/core/trace.h"
 #include "datasets/atomic_file.h"
 #include "harness/cli.h"
 #include "harness/hitfile.h"

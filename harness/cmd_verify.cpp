@@ -1,8 +1,8 @@
 // `accelbench verify (--mesh F | --scene F) [--accel all|NAME,...] [--rays FILE.rays | --kind KIND --count N]`
 // Traces with every named accelerator, with brute force and with Embree; prints the agreement table;
 // exit 1 on any hit that differs from brute's, or any disagreement with Embree that is not explained.
-#include "accel/registry.h"
-#include "accel/trace.h"
+#include "accel/core/registry.h"
+#include "accel/core/trace.h"
 #include "harness/cli.h"
 #include "harness/compare.h"
 #include "harness/hitfile.h"

@@ -1,8 +1,8 @@
 // Comparing hit arrays: byte-identical against brute, and the explained agreement with Embree.
 #pragma once
 
-#include "accel/geometry.h"
-#include "accel/triangle.h"
+#include "accel/core/aabb.h"
+#include "accel/core/triangle.h"
 
 #include <nlohmann/json.hpp>
 

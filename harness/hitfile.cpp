@@ -1,6 +1,6 @@
 #include "harness/hitfile.h"
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "datasets/atomic_file.h"
 
 #include <bit>

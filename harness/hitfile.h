@@ -1,7 +1,7 @@
 // The .rays and .hits files of the contract (little-endian, fixed-size records).
 #pragma once
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 #include <string>
 #include <vector>

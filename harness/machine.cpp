@@ -101,7 +101,7 @@ std::string build_flags() {
   try {
     const nlohmann::json db = nlohmann::json::parse(in);
     for (const auto& entry : db) {
-      if (entry.value("file", "").find("accel/trace.cpp") == std::string::npos) continue;
+      if (entry.value("file", "").find("accel/core/trace.cpp") == std::string::npos) continue;
       std::istringstream args(entry.value("command", ""));
       std::string arg, flags;
       args >> arg;  // the compiler

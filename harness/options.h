@@ -1,7 +1,7 @@
 // Options shared by several subcommands (--mesh/--scene, --param), added and read the same way everywhere.
 #pragma once
 
-#include "accel/params.h"
+#include "accel/core/params.h"
 
 #include <CLI/CLI.hpp>
 

@@ -10,8 +10,8 @@
 #include <iostream>
 #include <memory>
 
-#include "accel/registry.h"
-#include "accel/trace.h"
+#include "accel/core/registry.h"
+#include "accel/core/trace.h"
 #include "datasets/atomic_file.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"

@@ -8,9 +8,9 @@
 #include <set>
 #include <sstream>
 
-#include "accel/error.h"
-#include "accel/mesh.h"
-#include "accel/registry.h"
+#include "accel/core/error.h"
+#include "accel/core/mesh.h"
+#include "accel/core/registry.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 

@@ -1,7 +1,7 @@
 #include "harness/target.h"
 
-#include "accel/error.h"
-#include "accel/registry.h"
+#include "accel/core/error.h"
+#include "accel/core/registry.h"
 #include "datasets/mesh_io.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"

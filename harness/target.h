@@ -1,9 +1,9 @@
 // What the CLI traces: a mesh file or a scene file, loaded once, with the structures built over it.
 #pragma once
 
-#include "accel/accelerator.h"
-#include "accel/mesh.h"
-#include "accel/params.h"
+#include "accel/core/accelerator.h"
+#include "accel/core/mesh.h"
+#include "accel/core/params.h"
 #include "datasets/rays.h"
 #include "harness/compare.h"
 

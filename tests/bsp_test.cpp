@@ -1,6 +1,6 @@
 // BSP tree: cutting a cell box by a plane, traversal against brute on oblique flat geometry and on rays
 // lying in oblique planes, use of oblique planes, traversal cost on slanted slivers, thread independence.
-#include "accel/bsp.h"
+#include "accel/bsp/bsp.h"
 #include "structure_test_helpers.h"
 
 #include <tbb/global_control.h>

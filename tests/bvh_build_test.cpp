@@ -1,6 +1,6 @@
 // Tests of the BVH builders themselves (build_bvh): the presorted full sweep against a naive sweep that
 // re-sorts at every node, thread independence with the parallel paths forced on, forced splits.
-#include "accel/bvh_build.h"
+#include "accel/bvh/build.h"
 #include "tests/structure_test_helpers.h"
 
 #include <tbb/task_arena.h>

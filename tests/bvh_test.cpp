@@ -1,5 +1,5 @@
-#include "accel/bvh.h"
-#include "accel/sah.h"
+#include "accel/bvh/bvh.h"
+#include "accel/common/sah.h"
 #include "tests/structure_test_helpers.h"
 
 #include <tbb/task_arena.h>

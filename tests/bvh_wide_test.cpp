@@ -1,8 +1,9 @@
 // The 8-wide BVH: its SIMD box test against the scalar one, the four-lane kernel against the scalar
 // kernel (bit for bit), the collapsed tree's invariants and its thread independence.
-#include "accel/bvh.h"
-#include "accel/bvh_wide.h"
-#include "accel/triangle4.h"
+#include "accel/core/box_test.h"
+#include "accel/bvh/bvh.h"
+#include "accel/bvh/wide.h"
+#include "accel/core/triangle4.h"
 #include "tests/structure_test_helpers.h"
 
 #include <gtest/gtest.h>

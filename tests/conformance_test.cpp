@@ -1,9 +1,9 @@
 // Every registered structure of the project against brute force: byte-identical hits, the same
 // occlusion answers, at 1 and 2 threads, as bottom and as top level, on adversarial meshes and rays,
 // on every generator and ray kind, and on the real meshes. New structures are covered by registering.
-#include "accel/brute.h"
-#include "accel/registry.h"
-#include "accel/trace.h"
+#include "accel/reference/brute.h"
+#include "accel/core/registry.h"
+#include "accel/core/trace.h"
 #include "datasets/generators.h"
 #include "datasets/mesh_io.h"
 #include "datasets/random.h"

@@ -1,7 +1,7 @@
 // brute force against Embree on every generator and ray kind: every disagreement must be explained
 // (tie, edge, graze, t-limit); none may be unexplained.
-#include "accel/registry.h"
-#include "accel/trace.h"
+#include "accel/core/registry.h"
+#include "accel/core/trace.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/compare.h"

@@ -8,7 +8,7 @@
 #include <map>
 #include <set>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 
 namespace ab {
 namespace {

@@ -1,5 +1,5 @@
-#include "accel/geometry.h"
-#include "accel/triangle.h"
+#include "accel/core/box_test.h"
+#include "accel/core/triangle.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "accel/grid.h"
+#include "accel/grid/grid.h"
 #include "tests/structure_test_helpers.h"
 
 #include <tbb/task_arena.h>

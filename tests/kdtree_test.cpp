@@ -1,8 +1,8 @@
 // k-d trees (kdtree-median, kdtree-sah): node encoding, the plane step, flat geometry lying in split
 // planes, rays lying in split planes, statistics, thread-count independence and parameter checks.
-#include "accel/kd_node.h"
-#include "accel/kdtree.h"
-#include "accel/split_plane.h"
+#include "accel/common/spatial_tree.h"
+#include "accel/kdtree/kdtree.h"
+#include "accel/common/split_plane.h"
 #include "structure_test_helpers.h"
 
 #include <tbb/global_control.h>

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "datasets/generators.h"
 
 namespace ab {

@@ -2,12 +2,12 @@
 // structure and generator (single thread, closest hit), and of the builds (2 threads).
 // Sizes from the environment: ACCELBENCH_MICRO_TRIANGLES (default 100000), ACCELBENCH_MICRO_RAYS (100000).
 // Filter with --benchmark_filter, e.g. 'Trace/sphereflake/.*/(bvh-sah|embree)'.
-#include "accel/bvh.h"
-#include "accel/bvh_wide.h"
-#include "accel/triangle4.h"
-#include "accel/geometry.h"
-#include "accel/registry.h"
-#include "accel/triangle.h"
+#include "accel/bvh/bvh.h"
+#include "accel/bvh/wide.h"
+#include "accel/core/triangle4.h"
+#include "accel/core/box_test.h"
+#include "accel/core/registry.h"
+#include "accel/core/triangle.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/target.h"

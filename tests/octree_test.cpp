@@ -1,6 +1,6 @@
 // Octree: child boxes, traversal against brute on geometry and rays lying in the mid-planes, depth and
 // leaf-size limits, statistics and thread-count independence.
-#include "accel/octree.h"
+#include "accel/octree/octree.h"
 #include "structure_test_helpers.h"
 
 #include <tbb/global_control.h>

@@ -7,8 +7,8 @@
 #include <cstring>
 #include <memory>
 
-#include "accel/error.h"
-#include "accel/registry.h"
+#include "accel/core/error.h"
+#include "accel/core/registry.h"
 #include "datasets/generators.h"
 
 namespace ab {

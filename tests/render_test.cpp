@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "accel/registry.h"
+#include "accel/core/registry.h"
 #include "tracer/heatmap.h"
 #include "tracer/image.h"
 #include "tracer/integrator.h"

@@ -16,8 +16,8 @@
 #include <sstream>
 #include <thread>
 
-#include "accel/brute.h"
-#include "accel/registry.h"
+#include "accel/reference/brute.h"
+#include "accel/core/registry.h"
 #include "harness/cli.h"
 
 namespace ab {
@@ -30,10 +30,10 @@ namespace fs = std::filesystem;
 template <class P>
 class BrokenBrute final : public AcceleratorBase<BrokenBrute<P>> {
  public:
-  BrokenBrute(std::shared_ptr<const P> prims, Params& params)
-      : brute_(prims, params), prims_(std::move(prims)) {}
-  std::string name() const override { return "test-broken"; }
-  nlohmann::json config() const override { return nlohmann::json::object(); }
+  using Prims = P;
+  using Config = typename Brute<P>::Config;
+  BrokenBrute(std::shared_ptr<const P> prims, const Config& config)
+      : brute_(prims, config), prims_(std::move(prims)) {}
   AABB bounds() const override { return prims_->bounds(); }
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
@@ -46,7 +46,8 @@ class BrokenBrute final : public AcceleratorBase<BrokenBrute<P>> {
   }
 
  protected:
-  void do_build() override { this->stats_.primitives = prims_->size(); }
+  void do_build() override {}
+  void gather_stats(BuildStats& stats) const override { stats.primitives = prims_->size(); }
 
  private:
   Brute<P> brute_;

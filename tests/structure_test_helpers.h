@@ -1,11 +1,11 @@
 // Small inline meshes, ray sets and a brute-force comparison for the structure tests (bvh, grid).
 #pragma once
 
-#include "accel/brute.h"
-#include "accel/instances.h"
-#include "accel/mesh.h"
-#include "accel/primitives.h"
-#include "accel/registry.h"
+#include "accel/reference/brute.h"
+#include "accel/core/instances.h"
+#include "accel/core/mesh.h"
+#include "accel/core/primitives.h"
+#include "accel/core/registry.h"
 
 #include <gtest/gtest.h>
 

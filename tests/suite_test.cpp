@@ -9,8 +9,8 @@
 #include <set>
 #include <sstream>
 
-#include "accel/error.h"
-#include "accel/registry.h"
+#include "accel/core/error.h"
+#include "accel/core/registry.h"
 #include "datasets/generators.h"
 #include "harness/bench.h"
 #include "harness/report.h"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "tracer/scene.h"
 
 namespace ab {

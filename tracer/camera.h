@@ -4,7 +4,7 @@
 
 #include <glm/glm.hpp>
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 namespace ab {
 

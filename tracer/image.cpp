@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "datasets/atomic_file.h"
 
 // The one definition of stb_image_write and stb_image in the project.

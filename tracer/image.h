@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 namespace ab {
 

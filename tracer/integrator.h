@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/accelerator.h"
+#include "accel/core/accelerator.h"
 #include "tracer/image.h"
 #include "tracer/scene.h"
 

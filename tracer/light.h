@@ -1,7 +1,7 @@
 // Lights of the tracer: points and rectangles (area lights, sampled for soft shadows).
 #pragma once
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 namespace ab {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 namespace ab {
 

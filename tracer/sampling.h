@@ -6,7 +6,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "accel/geometry.h"
+#include "accel/core/aabb.h"
 
 namespace ab {
 

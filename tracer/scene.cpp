@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include "accel/error.h"
-#include "accel/params.h"
+#include "accel/core/error.h"
+#include "accel/core/params.h"
 #include "datasets/generators.h"
 #include "datasets/mesh_io.h"
 

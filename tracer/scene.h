@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/mesh.h"
+#include "accel/core/mesh.h"
 #include "tracer/camera.h"
 #include "tracer/light.h"
 #include "tracer/material.h"

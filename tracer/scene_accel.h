@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "accel/accelerator.h"
-#include "accel/instances.h"
-#include "accel/params.h"
+#include "accel/core/accelerator.h"
+#include "accel/core/instances.h"
+#include "accel/core/params.h"
 #include "tracer/scene.h"
 
 namespace ab {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "accel/error.h"
+#include "accel/core/error.h"
 #include "tracer/camera.h"
 #include "tracer/sampling.h"
 

@@ -1,0 +1,102 @@
+// Candidate split planes of the BSP tree and their surface-area cost, after Ize, Wald and Parker 2008
+// ("Ray tracing with the BSP tree") and Kammaje and Mora 2007 ("A study of restricted BSP trees for ray
+// tracing"): planes from a fixed set of 13 directions (the 3 axes, the 6 face diagonals and the 4 cube
+// diagonals), positioned at bin boundaries of the primitives' extents along each direction, plus the
+// supporting planes of a few of the node's own triangles (the autopartition). A plane is scored by the
+// SAH over the node's convex cell (bsp_cell.h). cut_box gives the bounding box of a box cut by a plane.
+#pragma once
+
+#include "accel/core/aabb.h"
+#include "accel/core/instances.h"
+#include "accel/core/primitives.h"
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace ab {
+
+/// A plane dot(n, x) = d with a unit normal; "below" is dot(n, x) < d.
+struct BspPlane {
+  vec3 n{1.0f, 0.0f, 0.0f};
+  float d = 0.0f;
+
+  /// Signed distance of p (positive above).
+  float distance(const vec3& p) const { return glm::dot(n, p) - d; }
+};
+static_assert(sizeof(BspPlane) == 16);
+
+/// The 13 fixed directions (unit length).
+inline const std::array<vec3, 13>& bsp_directions() {
+  static const std::array<vec3, 13> dirs = [] {
+    const std::array<vec3, 13> raw{vec3(1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1),  vec3(1, 1, 0),  vec3(1, -1, 0),
+                                   vec3(1, 0, 1), vec3(1, 0, -1), vec3(0, 1, 1), vec3(0, 1, -1), vec3(1, 1, 1),
+                                   vec3(1, 1, -1), vec3(1, -1, 1), vec3(-1, 1, 1)};
+    std::array<vec3, 13> out;
+    for (size_t i = 0; i < raw.size(); ++i) out[i] = glm::normalize(raw[i]);
+    return out;
+  }();
+  return dirs;
+}
+
+/// Most support points a primitive can have in a cell (a triangle clipped by a box).
+inline constexpr int kMaxSupportPoints = 32;
+
+/// The points whose convex hull holds the part of triangle i inside box: the triangle clipped to the box
+/// (Sutherland-Hodgman, clip.h). Zero points when it misses the box.
+inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec3* out) {
+  const Triangle& t = p.triangle(i);
+  ClipPolygon poly;
+  poly.v[0] = t.v0;
+  poly.v[1] = t.v1;
+  poly.v[2] = t.v2;
+  poly.n = 3;
+  const AABB tb = t.bounds();
+  if (!tb.overlaps(box)) return 0;
+  if (!(box.contains(tb.lo) && box.contains(tb.hi))) clip_polygon_to_box(poly, box);
+  for (int k = 0; k < poly.n; ++k) out[k] = poly.v[k];
+  return poly.n;
+}
+/// An instance's support points in box: the corners of its world box clipped to box.
+inline int support_points(const InstancePrims& p, size_t i, const AABB& box, vec3* out) {
+  const AABB b = AABB::intersection(p.bounds(i), box);
+  if (b.empty()) return 0;
+  for (int c = 0; c < 8; ++c) out[c] = vec3((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z);
+  return 8;
+}
+
+/// The supporting plane of triangle i (false for a degenerate triangle).
+inline bool supporting_plane(const TrianglePrims& p, size_t i, BspPlane& plane) {
+  const Triangle& t = p.triangle(i);
+  const vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
+  const float len = glm::length(n);
+  if (!(len > 0.0f) || !std::isfinite(len)) return false;
+  plane.n = n / len;
+  plane.d = glm::dot(plane.n, t.v0);
+  return std::isfinite(plane.d);
+}
+/// Instances offer no supporting plane (their boxes are classified by corners only).
+inline bool supporting_plane(const InstancePrims&, size_t, BspPlane&) { return false; }
+
+/// Bounding box of the part of box b with dot(n, x) <= d (below) or >= d (above): the corners on that side
+/// and the points where the plane cuts the twelve edges. Empty when that part is empty.
+inline AABB cut_box(const AABB& b, const BspPlane& plane, bool below) {
+  AABB out;
+  if (b.empty()) return out;
+  std::array<vec3, 8> c;
+  std::array<float, 8> s;
+  for (int k = 0; k < 8; ++k) {
+    c[k] = vec3((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
+    s[k] = below ? plane.distance(c[k]) : -plane.distance(c[k]);
+    if (s[k] <= 0.0f) out.extend(c[k]);
+  }
+  for (int k = 0; k < 8; ++k)
+    for (int bit = 1; bit < 8; bit <<= 1) {
+      const int j = k | bit;
+      if (j == k || !((s[k] < 0.0f && s[j] > 0.0f) || (s[k] > 0.0f && s[j] < 0.0f))) continue;
+      out.extend(c[k] + (s[k] / (s[k] - s[j])) * (c[j] - c[k]));
+    }
+  return AABB::intersection(out, b);
+}
+
+}  // namespace ab

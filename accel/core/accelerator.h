@@ -1,0 +1,123 @@
+// The accelerator interface: build, closest hit, any hit, bounds, statistics.
+// The virtual boundary is a batch of rays, so dispatch costs the same for every structure; the
+// per-ray loops below are non-virtual and inline the structure's traversal.
+#pragma once
+
+#include "accel/core/aabb.h"
+#include "accel/core/stats.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+
+namespace ab {
+
+/// An acceleration structure over one primitive set.
+class Accelerator {
+ public:
+  virtual ~Accelerator() = default;
+
+  /// Builds the structure and records the wall time of that build alone in stats().build_seconds; the
+  /// statistics of the finished structure are gathered afterwards (gather_stats), outside the timing.
+  void build() {
+    stats_ = BuildStats{};
+    const auto start = std::chrono::steady_clock::now();
+    do_build();
+    stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    gather_stats(stats_);
+  }
+
+  /// Registry name (for example "bvh-sah"), as the registry recorded it (identify()).
+  virtual std::string name() const { return name_; }
+  /// Effective configuration (every field, defaults included), as the registry recorded it.
+  virtual nlohmann::json config() const { return config_; }
+  /// Records the registry name and the effective configuration; the registry calls this once, when it
+  /// creates the structure, so a structure never repeats its own name or parameters.
+  void identify(std::string name, nlohmann::json config) {
+    name_ = std::move(name);
+    config_ = std::move(config);
+  }
+  /// Bounds of everything it holds.
+  virtual AABB bounds() const = 0;
+  /// Statistics of the last build.
+  const BuildStats& stats() const { return stats_; }
+
+  /// Closest hit of every ray (hits[i] is overwritten).
+  virtual void intersect(std::span<const Ray> rays, std::span<Hit> hits) const = 0;
+  /// Any hit within [tmin, tmax] of every ray (1 = occluded).
+  virtual void occluded(std::span<const Ray> rays, std::span<uint8_t> out) const = 0;
+  /// Closest hit with counters summed into `total` (the separate counting pass).
+  virtual void intersect_counted(std::span<const Ray> rays, std::span<Hit> hits, RayCounters& total) const = 0;
+  /// Any hit with counters summed into `total`.
+  virtual void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out, RayCounters& total) const = 0;
+
+  /// One ray against the structure as the bottom level of an instance: `best` holds the best hit so far
+  /// (from other instances) and is updated by the acceptance rule with instance id `inst`.
+  /// `counters` may be null (no counting).
+  virtual void intersect_one(const Ray& ray, Hit& best, uint32_t inst, RayCounters* counters) const = 0;
+  /// Any hit of one ray; `counters` may be null.
+  virtual bool occluded_one(const Ray& ray, RayCounters* counters) const = 0;
+
+ protected:
+  /// The build itself (timed). It may record figures only the build knows in stats_ (stats_ is reset
+  /// before it runs).
+  virtual void do_build() = 0;
+  /// Fills the statistics of the finished structure (not timed): most structures describe their tree to
+  /// the one statistics walk (accel/common/tree_stats.h) and add their bytes.
+  virtual void gather_stats(BuildStats& stats) const { (void)stats; }
+  BuildStats stats_;
+
+ private:
+  std::string name_;
+  nlohmann::json config_ = nlohmann::json::object();
+};
+
+/// Implements the batch entry points for a structure D that provides
+///   template <bool kCount> void intersect_ray(const Ray&, Hit& best, uint32_t inst, RayCounters&) const;
+///   template <bool kCount> bool occluded_ray(const Ray&, RayCounters&) const;
+template <class D>
+class AcceleratorBase : public Accelerator {
+ public:
+  void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    RayCounters unused;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      hits[i] = Hit{};
+      self().template intersect_ray<false>(rays[i], hits[i], kInvalidId, unused);
+    }
+  }
+  void occluded(std::span<const Ray> rays, std::span<uint8_t> out) const override {
+    RayCounters unused;
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = self().template occluded_ray<false>(rays[i], unused);
+  }
+  void intersect_counted(std::span<const Ray> rays, std::span<Hit> hits, RayCounters& total) const override {
+    for (size_t i = 0; i < rays.size(); ++i) {
+      hits[i] = Hit{};
+      self().template intersect_ray<true>(rays[i], hits[i], kInvalidId, total);
+    }
+  }
+  void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out, RayCounters& total) const override {
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = self().template occluded_ray<true>(rays[i], total);
+  }
+  void intersect_one(const Ray& ray, Hit& best, uint32_t inst, RayCounters* counters) const override {
+    if (counters) {
+      self().template intersect_ray<true>(ray, best, inst, *counters);
+    } else {
+      RayCounters unused;
+      self().template intersect_ray<false>(ray, best, inst, unused);
+    }
+  }
+  bool occluded_one(const Ray& ray, RayCounters* counters) const override {
+    if (counters) return self().template occluded_ray<true>(ray, *counters);
+    RayCounters unused;
+    return self().template occluded_ray<false>(ray, unused);
+  }
+
+ private:
+  const D& self() const { return static_cast<const D&>(*this); }
+};
+
+}  // namespace ab

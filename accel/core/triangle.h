@@ -1,0 +1,142 @@
+// The one ray/triangle kernel. Every structure calls intersect_triangle with the original ray and
+// the triangle's three vertices, so a triangle gives the same t, u, v whichever structure asks.
+#pragma once
+
+#include "accel/core/aabb.h"
+
+namespace ab {
+
+/// Three vertices of a triangle, in the order of the file (v0, v1, v2).
+struct Triangle {
+  vec3 v0, v1, v2;
+
+  /// Bounds of the three vertices.
+  AABB bounds() const {
+    AABB b;
+    b.extend(v0);
+    b.extend(v1);
+    b.extend(v2);
+    return b;
+  }
+  /// Centroid of the vertices.
+  vec3 centroid() const { return (v0 + v1 + v2) * (1.0f / 3.0f); }
+};
+static_assert(sizeof(Triangle) == 36);
+
+/// Relative bound on the rounding of the kernel's denominator (see intersect_triangle).
+inline constexpr float kCoplanarEps = 0x1p-18f;
+
+/// A candidate intersection produced by the kernel.
+struct TriangleHit {
+  float t, u, v;
+};
+
+/// Scalar lane helpers: absolute value, "no lane true", "both true".
+inline float lane_abs(float x) { return std::fabs(x); }
+inline bool lane_none(bool m) { return !m; }
+inline bool lane_and(bool a, bool b) { return a && b; }
+
+/// Three coordinates of lane type T (float here, four lanes in triangle4.h). The kernel below is written
+/// once over T, with glm's dot and cross expanded in glm's order, so the scalar and the four-lane kernels
+/// evaluate the same IEEE operations in the same order and give the same bits.
+template <class T>
+struct Vec3T {
+  T x, y, z;
+};
+
+template <class T>
+inline Vec3T<T> operator-(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T>
+inline T dot(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <class T>
+inline Vec3T<T> cross(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
+}
+/// |x| + |y| + |z| over lanes.
+template <class T>
+inline T l1_norm(const Vec3T<T>& a) {
+  return lane_abs(a.x) + lane_abs(a.y) + lane_abs(a.z);
+}
+
+/// The kernel's bound on the rounding of its denominator dot(dir, e1 x e2): relative kCoplanarEps of the
+/// L1 product of |dir|, |e1|, |e2|. A ray whose |den| does not exceed it counts as lying in the plane.
+template <class T>
+inline T parallel_bound(const Vec3T<T>& dir, const Vec3T<T>& e1, const Vec3T<T>& e2) {
+  return l1_norm(dir) * l1_norm(e1) * l1_norm(e2) * T(kCoplanarEps);
+}
+
+/// Moller and Trumbore 1997, "Fast, minimum storage ray-triangle intersection", written with the
+/// geometric normal n = e1 x e2 (as Embree does) so that a zero-area triangle, whose n is exactly the
+/// zero vector, has a zero denominator and never hits; nor does a ray lying in the triangle's plane.
+/// Single precision, no fused operations (the build uses -ffp-contract=off), so results are the same bits
+/// wherever it is inlined and for every lane type. Returns the lanes where tmin <= t <= tmax and the point
+/// lies inside or on the triangle (t, u, v are set where it is true); u and v are the weights of v1 and v2.
+template <class T>
+[[gnu::always_inline]] inline auto triangle_kernel(const Vec3T<T>& org, const Vec3T<T>& dir, T tmin, T tmax,
+                                                   const Vec3T<T>& v0, const Vec3T<T>& v1, const Vec3T<T>& v2,
+                                                   T& t, T& u, T& v) {
+  const Vec3T<T> e1 = v1 - v0;
+  const Vec3T<T> e2 = v2 - v0;
+  const Vec3T<T> n = cross(e1, e2);
+  const T den = dot(dir, n);
+  // A ray lying in the triangle's plane has den = 0 only in exact arithmetic; in floats it is rounding
+  // noise, and num/den then puts a "hit" anywhere along the ray, outside every box that holds the
+  // triangle. So den must exceed a bound on its rounding error (relative kCoplanarEps of the L1 product
+  // of |dir|, |e1|, |e2|), or the ray counts as parallel. The same rule for every structure keeps hits
+  // identical; such rays graze the plane within about 1e-5 radians (Embree's differ: verify calls them
+  // graze cases). Also rejects NaN.
+  auto ok = lane_abs(den) > parallel_bound(dir, e1, e2);
+  if (lane_none(ok)) return ok;
+  const T inv = T(1.0f) / den;
+  const Vec3T<T> to_origin = org - v0;
+  const Vec3T<T> c = cross(dir, to_origin);
+  u = dot(e2, c) * inv;
+  ok = lane_and(ok, u >= T(0.0f));
+  if (lane_none(ok)) return ok;
+  v = -dot(e1, c) * inv;
+  ok = lane_and(ok, lane_and(v >= T(0.0f), u + v <= T(1.0f)));
+  if (lane_none(ok)) return ok;
+  t = dot(v0 - org, n) * inv;
+  return lane_and(ok, lane_and(t >= tmin, t <= tmax));
+}
+
+/// A glm vector as kernel coordinates.
+inline Vec3T<float> to_lanes(const vec3& a) { return {a.x, a.y, a.z}; }
+
+/// True when the kernel treats the ray as lying in the triangle's plane (it never reports a hit then).
+inline bool kernel_calls_parallel(const Ray& ray, const Triangle& tri) {
+  const Vec3T<float> e1 = to_lanes(tri.v1) - to_lanes(tri.v0), e2 = to_lanes(tri.v2) - to_lanes(tri.v0);
+  const Vec3T<float> dir = to_lanes(ray.dir);
+  return !(lane_abs(dot(dir, cross(e1, e2))) > parallel_bound(dir, e1, e2));
+}
+
+/// The kernel for one triangle. Returns true and fills out on a hit.
+inline bool intersect_triangle(const Ray& ray, const Triangle& tri, TriangleHit& out) {
+  float t, u, v;
+  if (!triangle_kernel<float>(to_lanes(ray.org), to_lanes(ray.dir), ray.tmin, ray.tmax, to_lanes(tri.v0),
+                              to_lanes(tri.v1), to_lanes(tri.v2), t, u, v))
+    return false;
+  out = {t, u, v};
+  return true;
+}
+
+/// Records the kernel's hit of triangle `prim` of instance `inst` in `best` when the acceptance rule
+/// (is_better_hit) prefers it. Returns true when `best` changed.
+inline bool accept_hit(const TriangleHit& th, uint32_t prim, uint32_t inst, Hit& best) {
+  if (!is_better_hit(th.t, inst, prim, best)) return false;
+  best = {th.t, prim, inst, th.u, th.v};
+  return true;
+}
+
+/// Tests triangle `prim` of instance `inst` and, when it is hit and better than `best` by the
+/// one acceptance rule (is_better_hit), records it. Returns true when `best` changed.
+inline bool intersect_and_update(const Ray& ray, const Triangle& tri, uint32_t prim, uint32_t inst, Hit& best) {
+  TriangleHit th;
+  return intersect_triangle(ray, tri, th) && accept_hit(th, prim, inst, best);
+}
+
+}  // namespace ab

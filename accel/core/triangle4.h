@@ -1,0 +1,87 @@
+// Four triangles tested at once by the one kernel (triangle.h's triangle_kernel instantiated on four SSE
+// lanes), as Embree's Triangle4 leaves do. Every lane performs the scalar kernel's IEEE operations in the
+// same order, so each lane's t, u, v and verdict are the bits intersect_triangle gives for that triangle.
+#pragma once
+
+#include "accel/core/triangle.h"
+
+#include <immintrin.h>
+
+#include <cstdint>
+#include <span>
+
+namespace ab {
+
+/// Four floats in one SSE register, with the arithmetic the kernel uses (SSE2 only: comparisons are ordered,
+/// false on NaN, like the scalar ones).
+struct Lanes4 {
+  __m128 v;
+  Lanes4() = default;
+  explicit Lanes4(__m128 x) : v(x) {}
+  explicit Lanes4(float x) : v(_mm_set1_ps(x)) {}
+};
+/// A per-lane truth value (all bits set where true).
+struct Mask4 {
+  __m128 m;
+};
+inline Lanes4 operator+(Lanes4 a, Lanes4 b) { return Lanes4(_mm_add_ps(a.v, b.v)); }
+inline Lanes4 operator-(Lanes4 a, Lanes4 b) { return Lanes4(_mm_sub_ps(a.v, b.v)); }
+inline Lanes4 operator*(Lanes4 a, Lanes4 b) { return Lanes4(_mm_mul_ps(a.v, b.v)); }
+inline Lanes4 operator/(Lanes4 a, Lanes4 b) { return Lanes4(_mm_div_ps(a.v, b.v)); }
+inline Lanes4 operator-(Lanes4 a) { return Lanes4(_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))); }
+inline Mask4 operator>(Lanes4 a, Lanes4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline Mask4 operator>=(Lanes4 a, Lanes4 b) { return {_mm_cmpge_ps(a.v, b.v)}; }
+inline Mask4 operator<=(Lanes4 a, Lanes4 b) { return {_mm_cmple_ps(a.v, b.v)}; }
+inline Lanes4 lane_abs(Lanes4 a) { return Lanes4(_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)); }
+inline bool lane_none(Mask4 m) { return _mm_movemask_ps(m.m) == 0; }
+inline Mask4 lane_and(Mask4 a, Mask4 b) { return {_mm_and_ps(a.m, b.m)}; }
+
+/// Four triangles in structure-of-arrays form: v[vertex][axis][lane]. Unused lanes hold a zero-area
+/// triangle (all vertices at the origin), which the kernel never reports.
+struct alignas(16) Triangle4 {
+  float v[3][3][4];
+
+  /// Packs up to four triangles (the rest of the lanes are left zero-area).
+  static Triangle4 pack(std::span<const Triangle> tris) {
+    Triangle4 out{};
+    for (size_t k = 0; k < tris.size() && k < 4; ++k) {
+      const vec3* corners[3] = {&tris[k].v0, &tris[k].v1, &tris[k].v2};
+      for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a) out.v[c][a][k] = (*corners[c])[a];
+    }
+    return out;
+  }
+  /// One corner of all four lanes as kernel coordinates.
+  Vec3T<Lanes4> corner(int c) const {
+    return {Lanes4(_mm_load_ps(v[c][0])), Lanes4(_mm_load_ps(v[c][1])), Lanes4(_mm_load_ps(v[c][2]))};
+  }
+};
+static_assert(sizeof(Triangle4) == 144);
+
+/// A ray broadcast to four lanes (made once per ray).
+struct Ray4 {
+  explicit Ray4(const Ray& r)
+      : org{Lanes4(r.org.x), Lanes4(r.org.y), Lanes4(r.org.z)},
+        dir{Lanes4(r.dir.x), Lanes4(r.dir.y), Lanes4(r.dir.z)},
+        tmin(r.tmin),
+        tmax(r.tmax) {}
+  Vec3T<Lanes4> org, dir;
+  Lanes4 tmin, tmax;
+};
+
+/// The kernel on four triangles: returns the mask of lanes hit (bit k for lane k) and their t, u, v.
+[[gnu::always_inline]] inline unsigned intersect_triangle4(const Ray4& ray, const Triangle4& tris, float* t, float* u,
+                                                           float* v) {
+  Lanes4 lt, lu, lv;
+  const Mask4 hit =
+      triangle_kernel<Lanes4>(ray.org, ray.dir, ray.tmin, ray.tmax, tris.corner(0), tris.corner(1), tris.corner(2), lt, lu, lv);
+  const unsigned mask = unsigned(_mm_movemask_ps(hit.m));
+  if (mask) {
+    _mm_storeu_ps(t, lt.v);
+    _mm_storeu_ps(u, lu.v);
+    _mm_storeu_ps(v, lv.v);
+  }
+  return mask;
+}
+
+}  // namespace ab

@@ -1,0 +1,249 @@
+// Uniform grid over any primitive set: cells in compressed rows (offsets + ids), primitives inserted by
+// exact primitive/box overlap against conservatively inflated cells, traversal by 3D-DDA
+// (Amanatides and Woo 1987, "A fast voxel traversal algorithm for ray tracing") with a per-ray mailbox.
+#pragma once
+
+#include "accel/core/box_test.h"
+#include "accel/core/accelerator.h"
+#include "accel/core/params.h"
+#include "accel/core/primitives.h"
+
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace ab {
+
+/// Grid settings.
+struct GridConfig {
+  double lambda = 1.0;              ///< density: about lambda * cbrt(N) cells per axis for a cube (lambda^3 N cells)
+  uint64_t max_cells = 1ull << 24;  ///< cap on the number of cells
+};
+
+/// Reads a GridConfig from params (lambda, max_cells).
+GridConfig read_grid_config(Params& params);
+
+/// The geometry of a grid: its box, resolution and cell size. Cell (x, y, z) spans planes x..x+1 etc.
+struct GridLayout {
+  AABB box;
+  std::array<int, 3> res{0, 0, 0};
+  vec3 cell_size{0.0f};
+  vec3 inv_cell_size{0.0f};  ///< 0 on a flat axis (which always has one cell)
+
+  /// Number of cells.
+  size_t cells() const { return size_t(res[0]) * size_t(res[1]) * size_t(res[2]); }
+  /// Position of plane i (0..res) on axis a; plane res is exactly the box's upper face.
+  float plane(int a, int i) const { return i >= res[a] ? box.hi[a] : box.lo[a] + float(i) * cell_size[a]; }
+  /// Cell coordinate of position p on axis a, clamped to [0, res-1] (NaN gives 0).
+  int cell_of(int a, float p) const {
+    const float x = (p - box.lo[a]) * inv_cell_size[a];
+    if (!(x >= 0.0f)) return 0;
+    return x >= float(res[a] - 1) ? res[a] - 1 : int(x);
+  }
+  /// Linear index of cell (x, y, z).
+  size_t index(int x, int y, int z) const { return (size_t(z) * size_t(res[1]) + size_t(y)) * size_t(res[0]) + size_t(x); }
+  /// Box of cell (x, y, z).
+  AABB cell_box(int x, int y, int z) const {
+    return {{plane(0, x), plane(1, y), plane(2, z)}, {plane(0, x + 1), plane(1, y + 1), plane(2, z + 1)}};
+  }
+};
+
+/// Resolution for n primitives in bounds: cells per axis proportional to the extent, about
+/// lambda^3 * n cells overall, axes that would get less than one cell (flat ones) get one and the rest
+/// share the budget; capped at max_cells.
+GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& config);
+
+/// Cells in compressed rows: the ids of cell c are ids[offsets[c] .. offsets[c+1]), ascending.
+struct GridCells {
+  std::vector<uint32_t> offsets;
+  std::vector<uint32_t> ids;
+};
+
+/// Appends to `out` the cells primitive `id` goes into, each as (cell index << 32) | id, in ascending
+/// cell order.
+using CellInserter = std::function<void(uint32_t id, std::vector<uint64_t>& out)>;
+
+/// Exact overlap of primitive i with a box (the primitive set's overlaps()).
+using OverlapTest = std::function<bool(uint32_t, const AABB&)>;
+
+/// Generic insertion (any primitive set): every cell of the primitive's margin-widened bounds whose
+/// inflated box (inflate_for_insertion) the primitive overlaps according to `overlaps`.
+CellInserter box_test_inserter(const GridLayout& layout, std::span<const AABB> prim_bounds, OverlapTest overlaps);
+
+/// Triangle insertion by voxelization: the triangle is clipped to each slab of cells along z, the slab
+/// polygon to each row along y, and the row polygon's x extent gives the cells. Every slab, row and extent
+/// is widened by insertion_margin(), which covers every cell's inflate_for_insertion, so no cell the
+/// generic test would accept is lost.
+CellInserter triangle_inserter(const GridLayout& layout, std::span<const Triangle> triangles);
+
+/// Margin covering the inflation of every cell box of the grid (inflate_for_insertion grows a box by 2^-18
+/// of the largest of its extent and coordinates; this is twice that for the whole grid box).
+float insertion_margin(const GridLayout& layout);
+
+/// Two-pass insertion of primitives [0, n) (collect the (cell, id) pairs per block of primitives on TBB,
+/// then count and fill): deterministic for any thread count, the ids of every cell ascending.
+GridCells build_grid_cells(const GridLayout& layout, size_t n, const CellInserter& insert);
+
+/// A small direct-mapped per-ray mailbox (Amanatides and Woo 1987, section 4): remembers recently tested
+/// ids so a primitive spanning several cells is tested once. It lives on the tracing thread's stack, so it
+/// is thread-safe; a collision only costs a repeated test, never a skipped one.
+class Mailbox {
+ public:
+  Mailbox() { slots_.fill(kInvalidId); }
+  /// True when id was already tested for this ray; otherwise records it and returns false.
+  bool seen(uint32_t id) {
+    uint32_t& slot = slots_[id & (kSize - 1)];
+    if (slot == id) return true;
+    slot = id;
+    return false;
+  }
+
+ private:
+  static constexpr uint32_t kSize = 64;
+  std::array<uint32_t, kSize> slots_;
+};
+
+/// The state of a 3D-DDA walk: the current cell and, per axis, the step and the ray parameter of the
+/// next plane crossing (computed directly from the plane position each time, never accumulated).
+struct GridWalk {
+  int cell[3];
+  int step[3];
+  float t_next[3];
+
+  /// Starts the walk at parameter t0 (the ray's entry into the grid box).
+  GridWalk(const GridLayout& g, const Ray& ray, const RayBoxData& rd, float t0);
+  /// Parameter where the ray leaves the current cell.
+  float exit() const { return std::min(t_next[0], std::min(t_next[1], t_next[2])); }
+  /// Moves to the next cell; false when the ray leaves the grid.
+  bool advance(const GridLayout& g, const RayBoxData& rd) {
+    const int a = t_next[0] <= t_next[1] ? (t_next[0] <= t_next[2] ? 0 : 2) : (t_next[1] <= t_next[2] ? 1 : 2);
+    if (step[a] == 0) return false;
+    cell[a] += step[a];
+    if (cell[a] < 0 || cell[a] >= g.res[a]) return false;
+    t_next[a] = (g.plane(a, cell[a] + (step[a] > 0)) - rd.org[a]) * rd.inv_dir[a];
+    return true;
+  }
+};
+
+/// A uniform grid over primitive set P.
+template <class P>
+class Grid final : public AcceleratorBase<Grid<P>> {
+ public:
+  /// Reads the Config from params; the build is separate (build()).
+  Grid(std::shared_ptr<const P> prims, Params& params)
+      : prims_(std::move(prims)), config_(read_grid_config(params)), effective_(params.effective()) {}
+
+  std::string name() const override { return "grid"; }
+  nlohmann::json config() const override { return effective_; }
+  AABB bounds() const override { return prims_->bounds(); }
+  /// The grid's geometry (for tests).
+  const GridLayout& layout() const { return layout_; }
+  /// The cells (for tests).
+  const GridCells& cells() const { return cells_; }
+
+  /// Closest hit: walks the cells in ray order and stops once the best hit lies before the current
+  /// cell's exit (best.t < the exit distance widened towards the origin), so a primitive in a later cell,
+  /// which lies beyond that plane by more than the insertion margin, can neither beat nor tie it.
+  template <bool kCount>
+  void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+    if (cells_.ids.empty()) return;
+    const RayBoxData rd(ray);
+    float t0 = ray.tmin, t1 = std::min(ray.tmax, best.t);
+    if (!slab_test(layout_.box, rd, t0, t1)) return;
+    GridWalk walk(layout_, ray, rd, t0);
+    Mailbox mailbox;
+    for (;;) {
+      visit_cell<kCount>(walk, mailbox, c, [&](uint32_t id) { prims_->template intersect<kCount>(id, ray, best, inst, c); });
+      const float t_exit = widen_near(walk.exit());
+      if (best.t < t_exit || t_exit > t1 || !walk.advance(layout_, rd)) return;
+    }
+  }
+
+  /// Any hit within [tmin, tmax]: the same walk, stopping at the first primitive that reports one.
+  template <bool kCount>
+  bool occluded_ray(const Ray& ray, RayCounters& c) const {
+    if (cells_.ids.empty()) return false;
+    const RayBoxData rd(ray);
+    float t0 = ray.tmin, t1 = ray.tmax;
+    if (!slab_test(layout_.box, rd, t0, t1)) return false;
+    GridWalk walk(layout_, ray, rd, t0);
+    Mailbox mailbox;
+    for (;;) {
+      bool hit = false;
+      visit_cell<kCount>(walk, mailbox, c, [&](uint32_t id) {
+        return hit = prims_->template occluded<kCount>(id, ray, c);
+      });
+      if (hit) return true;
+      if (widen_near(walk.exit()) > t1 || !walk.advance(layout_, rd)) return false;
+    }
+  }
+
+ protected:
+  void do_build() override {
+    const size_t n = prims_->size();
+    layout_ = make_grid_layout(prims_->bounds(), n, config_);
+    if constexpr (std::is_same_v<P, TrianglePrims>) {
+      cells_ = build_grid_cells(layout_, n, triangle_inserter(layout_, prims_->triangles()));
+    } else {
+      std::vector<AABB> boxes(n);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) boxes[i] = prims_->bounds(i);
+      });
+      const P& prims = *prims_;
+      cells_ = build_grid_cells(layout_, n, box_test_inserter(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
+                                  return prims.overlaps(i, b);
+                                }));
+    }
+    fill_stats();
+  }
+
+ private:
+  /// Calls f(id) for each primitive of the walk's current cell not yet tested for this ray; stops early
+  /// when f returns true (f may return void).
+  template <bool kCount, class F>
+  void visit_cell(const GridWalk& walk, Mailbox& mailbox, RayCounters& c, F&& f) const {
+    const size_t cell = layout_.index(walk.cell[0], walk.cell[1], walk.cell[2]);
+    const uint32_t begin = cells_.offsets[cell], end = cells_.offsets[cell + 1];
+    if constexpr (kCount) {
+      ++c.nodes;
+      if (end > begin) ++c.leaves;
+    }
+    for (uint32_t k = begin; k < end; ++k) {
+      const uint32_t id = cells_.ids[k];
+      if (mailbox.seen(id)) {
+        if constexpr (kCount) ++c.mailbox_skips;
+        continue;
+      }
+      if constexpr (std::is_same_v<decltype(f(id)), bool>) {
+        if (f(id)) return;
+      } else {
+        f(id);
+      }
+    }
+  }
+
+  void fill_stats();
+
+  std::shared_ptr<const P> prims_;
+  GridConfig config_;
+  nlohmann::json effective_;
+  GridLayout layout_;
+  GridCells cells_;
+};
+
+/// Statistics of a built grid (cells, histogram, references, bytes, resolution).
+BuildStats grid_stats(const GridLayout& layout, const GridCells& cells, size_t primitives, const GridConfig& config);
+
+template <class P>
+void Grid<P>::fill_stats() {
+  this->stats_ = grid_stats(layout_, cells_, prims_->size(), config_);
+}
+
+}  // namespace ab

@@ -1,0 +1,12 @@
+#include "accel/kdtree/kdtree.h"
+
+#include "accel/core/registry.h"
+
+namespace ab {
+namespace {
+const Registrar kRegisterKdMedian{legacy_structure_info<KdTreeMedian>(
+    "kdtree-median", "k-d tree, median splits along the longest axis, conservative insertion", 30)};
+const Registrar kRegisterKdSah{legacy_structure_info<KdTreeSah>(
+    "kdtree-sah", "k-d tree, O(N log N) SAH build with perfect splits (Wald and Havran 2006)", 31)};
+}  // namespace
+}  // namespace ab

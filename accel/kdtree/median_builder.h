@@ -1,0 +1,119 @@
+// The traditional k-d tree build (Bentley 1975; the spatial-median k-d tree of the ray-tracing lectures):
+// each node splits at the median of its primitives' centres along its longest axis (or the axes in turn),
+// until a leaf holds at most leaf_size primitives, the depth limit is reached, or more than straddle_limit
+// of them would straddle the plane (then splitting mostly duplicates them). Primitives are tracked by
+// their perfect-split bounds inside the node box, and the partition is conservative: a primitive that
+// touches the plane or comes within the insertion margin of it goes to both children.
+#pragma once
+
+#include "accel/common/spatial_tree.h"
+
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace ab {
+
+/// Settings of the median k-d builder.
+struct KdMedianSettings {
+  size_t leaf_size = 4;        ///< a node with at most this many primitives is a leaf
+  int max_depth = 0;           ///< resolved depth limit (> 0)
+  bool cycle_axes = false;     ///< false: longest axis of the node box; true: x, y, z in turn
+  double straddle_limit = 0.75; ///< a node whose split would put more than this share of it on both sides is a leaf
+  size_t parallel_min = 16384; ///< nodes at least this large build their children in parallel
+};
+
+/// Builds median-split k-d trees over a primitive set P.
+template <class P>
+class KdMedianBuilder {
+ public:
+  /// A primitive in a node: its id and its bounds clipped to the node box.
+  struct Ref {
+    uint32_t id;
+    AABB cb;
+  };
+
+  /// Builder over prims with settings s.
+  KdMedianBuilder(const P& prims, const KdMedianSettings& s) : prims_(prims), s_(s) {}
+
+  /// Builds the tree over the primitives ids (finite bounds) inside box into out.
+  void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
+    std::vector<Ref> refs(ids.size());
+    for (size_t i = 0; i < ids.size(); ++i) refs[i] = {ids[i], prims_.clipped_bounds(ids[i], box)};
+    build_node(std::move(refs), box, 0, out);
+  }
+
+ private:
+  void build_node(std::vector<Ref>&& refs, const AABB& box, int depth, KdBuffer& out) const {
+    const size_t n = refs.size();
+    int axis = s_.cycle_axes ? depth % 3 : box.longest_axis();
+    float split = 0.0f;
+    if (n <= s_.leaf_size || depth >= s_.max_depth || !median_plane(refs, box, axis, split)) {
+      make_leaf(refs, out);
+      return;
+    }
+    std::vector<Ref> left, right;
+    AABB lbox = box, rbox = box;
+    lbox.hi[axis] = split;
+    rbox.lo[axis] = split;
+    partition(refs, axis, split, insertion_margin(box), lbox, rbox, left, right);
+    if (double(left.size() + right.size()) > double(n) * (1.0 + s_.straddle_limit)) {  // splitting no longer pays
+      make_leaf(refs, out);
+      return;
+    }
+    std::vector<Ref>().swap(refs);
+    const size_t self = out.nodes.size();
+    out.nodes.push_back(KdNode::leaf(0, 0));
+    if (n >= s_.parallel_min) {
+      KdBuffer lb, rb;
+      tbb::parallel_invoke([&] { build_node(std::move(left), lbox, depth + 1, lb); },
+                           [&] { build_node(std::move(right), rbox, depth + 1, rb); });
+      out.append(lb);
+      out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
+      out.append(rb);
+    } else {
+      build_node(std::move(left), lbox, depth + 1, out);
+      out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
+      build_node(std::move(right), rbox, depth + 1, out);
+    }
+  }
+
+  /// Median of the clipped centres along axis; false when it does not lie strictly inside the box.
+  static bool median_plane(const std::vector<Ref>& refs, const AABB& box, int axis, float& split) {
+    std::vector<float> c(refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) c[i] = 0.5f * (refs[i].cb.lo[axis] + refs[i].cb.hi[axis]);
+    auto mid = c.begin() + c.size() / 2;
+    std::nth_element(c.begin(), mid, c.end());
+    split = *mid;
+    return split > box.lo[axis] && split < box.hi[axis];
+  }
+
+  void partition(const std::vector<Ref>& refs, int axis, float split, float margin, const AABB& lbox,
+                 const AABB& rbox, std::vector<Ref>& left, std::vector<Ref>& right) const {
+    for (const Ref& r : refs) {
+      const bool to_left = r.cb.lo[axis] <= split + margin;
+      const bool to_right = r.cb.hi[axis] >= split - margin;
+      if (to_left && to_right) {
+        left.push_back({r.id, clip_into_child(prims_, r.id, lbox, margin)});
+        right.push_back({r.id, clip_into_child(prims_, r.id, rbox, margin)});
+      } else if (to_left) {
+        left.push_back(r);
+      } else {
+        right.push_back(r);
+      }
+    }
+  }
+
+  static void make_leaf(const std::vector<Ref>& refs, KdBuffer& out) {
+    std::vector<uint32_t> ids(refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) ids[i] = refs[i].id;
+    std::sort(ids.begin(), ids.end());
+    out.add_leaf(ids);
+  }
+
+  const P& prims_;
+  KdMedianSettings s_;
+};
+
+}  // namespace ab

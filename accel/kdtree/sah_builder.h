@@ -1,0 +1,290 @@
+// The O(N log N) SAH k-d tree build of Wald and Havran 2006, "On building fast kd-trees for ray tracing,
+// and on doing that in O(N log N)": every node keeps, per axis, the list of its primitives' start, end and
+// planar events sorted once at the root; the best plane of all three axes is found by one linear sweep,
+// and the lists are split into the children's lists in linear time (primitives on one side keep their
+// events in order; straddling ones are clipped to each child box, "perfect splits", and their few new
+// events sorted and merged). Cost model: C = lambda (Ct + Ci (P_L N_L + P_R N_R)) with lambda = 1 - bonus
+// when one side is empty; planar primitives are counted on the cheaper side; a node becomes a leaf when
+// no plane beats Ci N. The upper levels build in parallel on TBB; the tree is the same for any thread
+// count (every subtree is built deterministically and spliced in a fixed order).
+//
+// Robustness without duplicating every primitive that touches a plane: the traversal widens the two
+// halves of the ray interval around t_split (split_plane.h), so a hit on the plane itself (flat geometry
+// lying in it, a vertex or edge touching it) is found on whichever side the primitive was placed; the
+// straddling primitives are clipped into boxes grown by the insertion margin, so clipping rounding never
+// drops a sliver.
+#pragma once
+
+#include "accel/common/spatial_tree.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace ab {
+
+/// Settings of the SAH k-d builder.
+struct KdSahSettings {
+  float traversal_cost = 1.0f;    ///< Ct
+  float intersection_cost = 1.5f; ///< Ci
+  float empty_bonus = 0.2f;       ///< 1 - lambda for splits with an empty side
+  int max_depth = 0;              ///< resolved depth limit (> 0)
+  size_t parallel_min = 16384;    ///< nodes at least this large build their children in parallel
+};
+
+/// A sweep event: position along one axis and (primitive's index in its node << 2 | type).
+struct KdEvent {
+  float pos;
+  uint32_t key;
+
+  /// Event types, in the order the sweep needs at one position: ends, planars, starts.
+  enum Type : uint32_t { kEnd = 0, kPlanar = 1, kStart = 2 };
+  /// Index of the primitive in its node.
+  uint32_t local() const { return key >> 2; }
+  /// The event's type.
+  uint32_t type() const { return key & 3u; }
+  /// Total order: position, then type, then primitive (so any sort gives the same list).
+  bool operator<(const KdEvent& o) const {
+    if (pos != o.pos) return pos < o.pos;
+    const uint32_t ta = type(), tb = o.type();
+    return ta != tb ? ta < tb : key < o.key;
+  }
+};
+
+/// A node under construction: box, primitive ids and the sorted events of each axis.
+struct KdEventNode {
+  AABB box;
+  std::vector<uint32_t> ids;
+  std::array<std::vector<KdEvent>, 3> events;
+};
+
+/// Appends the events of a primitive with clipped bounds cb as local index `local`.
+inline void add_kd_events(const AABB& cb, uint32_t local, std::array<std::vector<KdEvent>, 3>& ev) {
+  for (int a = 0; a < 3; ++a) {
+    if (cb.lo[a] == cb.hi[a]) {
+      ev[a].push_back({cb.lo[a], (local << 2) | KdEvent::kPlanar});
+    } else {
+      ev[a].push_back({cb.lo[a], (local << 2) | KdEvent::kStart});
+      ev[a].push_back({cb.hi[a], (local << 2) | KdEvent::kEnd});
+    }
+  }
+}
+
+/// Result of the sweep.
+struct KdSahPlane {
+  int axis = -1;         ///< -1: no plane inside the box
+  float pos = 0.0f;
+  float cost = kInf;
+  bool planar_left = true;  ///< planar primitives at pos are counted on the left
+  uint32_t n_left = 0, n_right = 0;
+};
+
+/// Wald-Havran SAH cost of a plane with counts and areas (areas relative to the node's).
+inline float kd_sah_cost(const KdSahSettings& s, float pl, float pr, uint32_t nl, uint32_t nr) {
+  const float lambda = (nl == 0 || nr == 0) ? 1.0f - s.empty_bonus : 1.0f;
+  return lambda * (s.traversal_cost + s.intersection_cost * (pl * float(nl) + pr * float(nr)));
+}
+
+/// Area terms of the children of a node box along one axis, so that each plane costs a few flops.
+struct KdAxisAreas {
+  float lo, hi, cap, side, inv_area;  ///< child area = (cap + side * length) * inv_area
+
+  /// Terms of box along axis a.
+  KdAxisAreas(const AABB& box, int a) : lo(box.lo[a]), hi(box.hi[a]) {
+    const vec3 e = box.extent();
+    const float e1 = e[(a + 1) % 3], e2 = e[(a + 2) % 3];
+    cap = 2.0f * e1 * e2;
+    side = 2.0f * (e1 + e2);
+    inv_area = 1.0f / box.area();
+  }
+};
+
+/// Evaluates plane `pos` on axis a with the paper's counts, both placements of planar primitives.
+inline void evaluate_kd_plane(const KdSahSettings& s, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
+                              uint32_t np, uint32_t nr, KdSahPlane& best) {
+  const float pl = (ar.cap + ar.side * (pos - ar.lo)) * ar.inv_area;
+  const float pr = (ar.cap + ar.side * (ar.hi - pos)) * ar.inv_area;
+  const float cl = kd_sah_cost(s, pl, pr, nl + np, nr);
+  const float cr = np ? kd_sah_cost(s, pl, pr, nl, nr + np) : cl;
+  const float c = std::min(cl, cr);
+  if (c < best.cost) best = {a, pos, c, cl <= cr, cl <= cr ? nl + np : nl, cl <= cr ? nr : nr + np};
+}
+
+/// Finds the cheapest plane strictly inside the node box by one sweep per axis (Wald and Havran 2006,
+/// algorithm 4).
+inline KdSahPlane find_kd_sah_plane(const KdSahSettings& s, const KdEventNode& node) {
+  KdSahPlane best;
+  if (!(node.box.area() > 0.0f)) return best;
+  const uint32_t n = uint32_t(node.ids.size());
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<KdEvent>& ev = node.events[a];
+    const KdAxisAreas ar(node.box, a);
+    uint32_t nl = 0, nr = n;
+    for (size_t i = 0; i < ev.size();) {
+      const float p = ev[i].pos;
+      uint32_t ends = 0, planars = 0, starts = 0;
+      for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kEnd; ++i) ++ends;
+      for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kPlanar; ++i) ++planars;
+      for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kStart; ++i) ++starts;
+      nr -= planars + ends;
+      if (p > node.box.lo[a] && p < node.box.hi[a]) evaluate_kd_plane(s, ar, a, p, nl, planars, nr, best);
+      nl += starts + planars;
+    }
+  }
+  return best;
+}
+
+/// Builds SAH k-d trees over a primitive set P.
+template <class P>
+class KdSahBuilder {
+ public:
+  /// Builder over prims with settings s.
+  KdSahBuilder(const P& prims, const KdSahSettings& s) : prims_(prims), s_(s) {}
+
+  /// Builds the tree over the primitives `ids` (finite bounds) inside `box` into out.
+  void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
+    KdEventNode root = make_root(ids, box);
+    build_node(std::move(root), 0, out);
+  }
+
+ private:
+  KdEventNode make_root(const std::vector<uint32_t>& ids, const AABB& box) const {
+    KdEventNode root;
+    root.box = box;
+    root.ids = ids;
+    for (auto& ev : root.events) ev.resize(2 * ids.size());
+    std::vector<uint8_t> used(ids.size() * 3);
+    tbb::parallel_for(size_t(0), ids.size(), [&](size_t i) {
+      const AABB cb = prims_.clipped_bounds(ids[i], box);
+      for (int a = 0; a < 3; ++a) {
+        const uint32_t key = uint32_t(i) << 2;
+        KdEvent* slot = &root.events[a][2 * i];
+        if (cb.lo[a] == cb.hi[a]) {
+          slot[0] = {cb.lo[a], key | KdEvent::kPlanar};
+          used[3 * i + a] = 1;
+        } else {
+          slot[0] = {cb.lo[a], key | KdEvent::kStart};
+          slot[1] = {cb.hi[a], key | KdEvent::kEnd};
+          used[3 * i + a] = 2;
+        }
+      }
+    });
+    for (int a = 0; a < 3; ++a) {
+      std::vector<KdEvent>& ev = root.events[a];
+      size_t k = 0;
+      for (size_t i = 0; i < ids.size(); ++i)
+        for (uint8_t j = 0; j < used[3 * i + a]; ++j) ev[k++] = ev[2 * i + j];
+      ev.resize(k);
+    }
+    tbb::parallel_for(0, 3, [&](int a) { tbb::parallel_sort(root.events[a].begin(), root.events[a].end()); });
+    return root;
+  }
+
+  void build_node(KdEventNode&& node, int depth, KdBuffer& out) const {
+    const size_t n = node.ids.size();
+    KdSahPlane plane;
+    if (n > 0 && depth < s_.max_depth) plane = find_kd_sah_plane(s_, node);
+    if (plane.axis < 0 || plane.cost >= s_.intersection_cost * float(n)) {
+      out.add_leaf(node.ids);
+      return;
+    }
+    const float split = plane.pos;
+    KdEventNode left, right;
+    partition(std::move(node), plane.axis, split, plane.planar_left, left, right);
+    if (left.ids.size() == n && right.ids.size() == n) {
+      out.add_leaf(left.ids);
+      return;
+    }
+    const size_t self = out.nodes.size();
+    out.nodes.push_back(KdNode::leaf(0, 0));
+    if (n >= s_.parallel_min) {
+      KdBuffer lb, rb;
+      tbb::parallel_invoke([&] { build_node(std::move(left), depth + 1, lb); },
+                           [&] { build_node(std::move(right), depth + 1, rb); });
+      out.append(lb);
+      out.nodes[self] = KdNode::interior(plane.axis, split, uint32_t(out.nodes.size()));
+      out.append(rb);
+    } else {
+      build_node(std::move(left), depth + 1, out);
+      out.nodes[self] = KdNode::interior(plane.axis, split, uint32_t(out.nodes.size()));
+      build_node(std::move(right), depth + 1, out);
+    }
+  }
+
+  /// Splits node's primitives and events at `split` on axis a into left and right (linear time).
+  void partition(KdEventNode&& node, int a, float split, bool planar_left, KdEventNode& left,
+                 KdEventNode& right) const {
+    const size_t n = node.ids.size();
+    const float margin = insertion_margin(node.box);
+    left.box = node.box;
+    right.box = node.box;
+    left.box.hi[a] = split;
+    right.box.lo[a] = split;
+    // Side of each primitive (bit 0 left, bit 1 right), Wald and Havran's classification: ending at or
+    // before the plane is left only, starting at or after it right only, planar in it on the chosen side.
+    std::vector<uint8_t> side(n, 3);
+    for (const KdEvent& e : node.events[a]) {
+      const uint32_t t = e.local();
+      if (e.type() == KdEvent::kEnd && e.pos <= split) side[t] = 1;
+      else if (e.type() == KdEvent::kStart && e.pos >= split) side[t] = 2;
+      else if (e.type() == KdEvent::kPlanar) side[t] = e.pos < split ? 1 : e.pos > split ? 2 : planar_left ? 1 : 2;
+    }
+    std::vector<uint32_t> to_left(n), to_right(n);
+    for (size_t t = 0; t < n; ++t) {
+      if (side[t] & 1) {
+        to_left[t] = uint32_t(left.ids.size());
+        left.ids.push_back(node.ids[t]);
+      }
+      if (side[t] & 2) {
+        to_right[t] = uint32_t(right.ids.size());
+        right.ids.push_back(node.ids[t]);
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      const size_t m = node.events[k].size();
+      left.events[k].reserve(m * left.ids.size() / n + 8);
+      right.events[k].reserve(m * right.ids.size() / n + 8);
+      split_events(node.events[k], side, to_left, to_right, left.events[k], right.events[k]);
+      std::vector<KdEvent>().swap(node.events[k]);
+    }
+    add_straddlers(node.ids, side, to_left, margin, left);
+    add_straddlers(node.ids, side, to_right, margin, right);
+  }
+
+  /// Events of one-sided primitives keep their order in their side's list.
+  static void split_events(const std::vector<KdEvent>& ev, const std::vector<uint8_t>& side,
+                           const std::vector<uint32_t>& to_left, const std::vector<uint32_t>& to_right,
+                           std::vector<KdEvent>& left, std::vector<KdEvent>& right) {
+    for (const KdEvent& e : ev) {
+      const uint32_t t = e.local();
+      if (side[t] == 1) left.push_back({e.pos, (to_left[t] << 2) | e.type()});
+      else if (side[t] == 2) right.push_back({e.pos, (to_right[t] << 2) | e.type()});
+    }
+  }
+
+  /// Clips the primitives on both sides into child (perfect splits), sorts their events and merges them in.
+  void add_straddlers(const std::vector<uint32_t>& ids, const std::vector<uint8_t>& side,
+                      const std::vector<uint32_t>& to_child, float margin, KdEventNode& child) const {
+    std::array<std::vector<KdEvent>, 3> extra;
+    for (size_t t = 0; t < ids.size(); ++t) {
+      if (side[t] != 3) continue;
+      add_kd_events(clip_into_child(prims_, ids[t], child.box, margin), to_child[t], extra);
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (extra[k].empty()) continue;
+      std::sort(extra[k].begin(), extra[k].end());
+      std::vector<KdEvent> merged(child.events[k].size() + extra[k].size());
+      std::merge(child.events[k].begin(), child.events[k].end(), extra[k].begin(), extra[k].end(), merged.begin());
+      child.events[k].swap(merged);
+    }
+  }
+
+  const P& prims_;
+  KdSahSettings s_;
+};
+
+}  // namespace ab
