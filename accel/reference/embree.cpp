@@ -1,40 +1,11 @@
 #include "accel/reference/embree.h"
 
-#include "accel/core/error.h"
 #include "accel/core/registry.h"
-
-#include <atomic>
-#include <cstring>
-#include <mutex>
 
 namespace ab {
 
-namespace {
-std::atomic<int64_t> g_embree_bytes{0};
-
-bool monitor(void*, ssize_t bytes, bool) {
-  g_embree_bytes += bytes;
-  return true;
-}
-}  // namespace
-
-RTCDevice embree_device() {
-  static RTCDevice device = [] {
-    RTCDevice d = rtcNewDevice(nullptr);
-    if (!d) throw InputError("embree: cannot create a device");
-    rtcSetDeviceMemoryMonitorFunction(d, monitor, nullptr);
-    return d;
-  }();
-  return device;
-}
-
-int64_t embree_bytes_in_use() { return g_embree_bytes.load(); }
-
-EmbreeMesh::EmbreeMesh(std::shared_ptr<const TrianglePrims> prims, Params& params) : prims_(std::move(prims)) {
-  const std::string q = params.get_choice("quality", "medium", {"low", "medium", "high"});
-  quality_ = q == "low" ? RTC_BUILD_QUALITY_LOW : q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
-  config_ = params.effective();
-}
+EmbreeMesh::EmbreeMesh(std::shared_ptr<const TrianglePrims> prims, const Config& config)
+    : prims_(std::move(prims)), config_(config) {}
 
 EmbreeMesh::~EmbreeMesh() {
   if (scene_) rtcReleaseScene(scene_);
@@ -42,32 +13,17 @@ EmbreeMesh::~EmbreeMesh() {
 
 void EmbreeMesh::do_build() {
   if (scene_) rtcReleaseScene(scene_);
-  RTCDevice device = embree_device();
+  scene_ = nullptr;
   const int64_t bytes_before = embree_bytes_in_use();
-  scene_ = rtcNewScene(device);
-  rtcSetSceneBuildQuality(scene_, quality_);
-  const Mesh& mesh = prims_->mesh();
-  if (mesh.size() > 0) {
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(geom, quality_);
-    // Embree reads vertex buffers with 16-byte loads: allocate through it (it pads the last element).
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                 sizeof(float) * 3, mesh.vertices.size()));
-    std::memcpy(vertices, mesh.vertices.data(), sizeof(float) * 3 * mesh.vertices.size());
-    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                   sizeof(uint32_t) * 3, mesh.size()));
-    std::memcpy(indices, mesh.triangles.data(), sizeof(uint32_t) * 3 * mesh.size());
-    rtcCommitGeometry(geom);
-    rtcAttachGeometryByID(scene_, geom, 0);
-    rtcReleaseGeometry(geom);
-  }
-  rtcCommitScene(scene_);
-  stats_ = BuildStats{};
-  stats_.primitives = mesh.size();
-  stats_.references = mesh.size();
+  scene_ = commit_mesh_scene(prims_->mesh(), config_.quality, RTC_SCENE_FLAG_NONE);
   const int64_t grown = embree_bytes_in_use() - bytes_before;
   stats_.bytes = grown > 0 ? static_cast<uint64_t>(grown) : 0;
-  stats_.extra["note"] = "bytes from Embree's memory monitor (BVH plus its copy of the mesh buffers)";
+}
+
+void EmbreeMesh::gather_stats(BuildStats& stats) const {
+  stats.primitives = prims_->size();
+  stats.references = prims_->size();
+  stats.extra["note"] = "bytes from Embree's memory monitor (BVH plus its copy of the mesh buffers)";
 }
 
 void EmbreeMesh::intersect(std::span<const Ray> rays, std::span<Hit> hits) const {
@@ -89,9 +45,9 @@ void EmbreeMesh::occluded(std::span<const Ray> rays, std::span<uint8_t> out) con
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   for (size_t i = 0; i < rays.size(); ++i) {
-    RTCRayHit rh = to_embree(rays[i]);
-    rtcOccluded1(scene_, &context, &rh.ray);
-    out[i] = rh.ray.tfar < 0.0f;  // Embree sets tfar = -inf when occluded
+    RTCRay r = to_embree(rays[i]).ray;
+    rtcOccluded1(scene_, &context, &r);
+    out[i] = embree_occluded(r);
   }
 }
 
@@ -118,15 +74,16 @@ bool EmbreeMesh::occluded_one(const Ray& ray, RayCounters*) const {
 }
 
 namespace {
+/// Through the registry like every structure (create_structure reads the Config once; the registry records
+/// the name and the effective parameters), over meshes only: a scene uses Embree's own instancing
+/// (embree_scene.h).
 const Registrar kRegisterEmbree{[] {
   AcceleratorInfo info;
-  info.name = "embree";
+  info.name = kEmbreeName;
   info.description = "Intel Embree 3 (the reference); quality=low|medium|high";
   info.order = 1;
   info.is_reference = true;
-  info.make_for_mesh = [](std::shared_ptr<const TrianglePrims> p, Params& params) -> std::unique_ptr<Accelerator> {
-    return std::make_unique<EmbreeMesh>(std::move(p), params);
-  };
+  info.make_for_mesh = create_structure<EmbreeMesh>;
   return info;
 }()};
 }  // namespace

@@ -1,36 +1,33 @@
-// Intel Embree 3 behind the accelerator interface: the reference and the bar to beat.
+// Intel Embree 3 over one triangle mesh, behind the accelerator interface: the reference and the bar to beat.
 #pragma once
-
-#include "accel/core/accelerator.h"
-#include "accel/core/params.h"
-#include "accel/core/primitives.h"
-
-#include <embree3/rtcore.h>
 
 #include <memory>
 
+#include "accel/core/accelerator.h"
+#include "accel/core/primitives.h"
+#include "accel/reference/embree_device.h"
+
 namespace ab {
 
-/// The process-wide Embree device (created on first use; its memory monitor counts bytes per build).
-RTCDevice embree_device();
-/// Bytes Embree currently holds (from the device's memory monitor).
-int64_t embree_bytes_in_use();
-
-/// Embree over one triangle mesh: primID = triangle id, geomID 0. Parameters: quality = low|medium|high
-/// (RTC_BUILD_QUALITY_*), default medium. Counters are not available (Embree does not expose them): the
-/// counted entry points report zeros.
+/// Embree over one triangle mesh: primID = triangle id, geomID 0, registered as `embree` (a reference, not a
+/// structure of the project's own). Parameter: quality = low|medium|high (EmbreeConfig). Counters are not
+/// available (Embree does not expose them): the counted entry points report zeros.
 class EmbreeMesh final : public Accelerator {
  public:
-  /// Reads `quality` from params.
-  EmbreeMesh(std::shared_ptr<const TrianglePrims> prims, Params& params);
+  using Prims = TrianglePrims;  ///< over triangle meshes only (a scene uses embree_scene.h)
+  using Config = EmbreeConfig;  ///< the build quality
+
+  /// Over prims, built at config.quality.
+  EmbreeMesh(std::shared_ptr<const TrianglePrims> prims, const Config& config);
+  /// Releases the Embree scene; not copyable (it owns it).
   ~EmbreeMesh() override;
   EmbreeMesh(const EmbreeMesh&) = delete;
   EmbreeMesh& operator=(const EmbreeMesh&) = delete;
 
-  std::string name() const override { return "embree"; }
-  nlohmann::json config() const override { return config_; }
+  /// Bounds of the mesh.
   AABB bounds() const override { return prims_->bounds(); }
 
+  /// The accelerator interface, each ray through rtcIntersect1 / rtcOccluded1 (counters stay zero).
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override;
   void occluded(std::span<const Ray> rays, std::span<uint8_t> out) const override;
   void intersect_counted(std::span<const Ray> rays, std::span<Hit> hits, RayCounters& total) const override;
@@ -42,34 +39,14 @@ class EmbreeMesh final : public Accelerator {
   RTCScene scene() const { return scene_; }
 
  protected:
+  /// Uploads the mesh and commits the scene; records the bytes Embree's memory monitor saw it take.
   void do_build() override;
+  void gather_stats(BuildStats& stats) const override;
 
  private:
   std::shared_ptr<const TrianglePrims> prims_;
-  nlohmann::json config_;
-  RTCBuildQuality quality_ = RTC_BUILD_QUALITY_MEDIUM;
+  Config config_;
   RTCScene scene_ = nullptr;
 };
-
-/// Converts a ray to Embree's RTCRayHit (tnear = tmin, tfar = tmax, mask all, no time).
-inline RTCRayHit to_embree(const Ray& r) {
-  RTCRayHit rh;
-  rh.ray.org_x = r.org.x;
-  rh.ray.org_y = r.org.y;
-  rh.ray.org_z = r.org.z;
-  rh.ray.dir_x = r.dir.x;
-  rh.ray.dir_y = r.dir.y;
-  rh.ray.dir_z = r.dir.z;
-  rh.ray.tnear = r.tmin;
-  rh.ray.tfar = r.tmax;
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  return rh;
-}
 
 }  // namespace ab

@@ -9,21 +9,20 @@
 #include "accel/core/accelerator.h"
 #include "accel/core/mesh.h"
 #include "accel/core/params.h"
+#include "accel/reference/embree_device.h"
 
 namespace ab {
 
-/// The registry name of Embree.
-inline constexpr const char* kEmbreeName = "embree";
-
 /// One instance: a base mesh index and its object-to-world matrix.
 struct EmbreeInstanceInput {
-  uint32_t mesh = 0;
-  glm::mat4 to_world{1.0f};
+  uint32_t mesh = 0;         ///< index of the base mesh
+  glm::mat4 to_world{1.0f};  ///< object-to-world matrix
 };
 
 /// Creates (does not build) an Embree scene: one Embree scene per base mesh, each committed once, and
 /// a top scene with one instance geometry per instance (geometry id = instance index, so Embree's
-/// instID is the contract's `inst`). Parameter: quality=low|medium|high (build quality, default high).
+/// instID is the contract's `inst`). Parameters: EmbreeConfig (quality=low|medium|high, default medium),
+/// checked and recorded as the registry does for every structure (name `embree`, effective config).
 std::unique_ptr<Accelerator> make_embree_scene(std::vector<std::shared_ptr<const Mesh>> meshes,
                                                std::vector<EmbreeInstanceInput> instances, Params& params);
 

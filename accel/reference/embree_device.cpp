@@ -1,0 +1,75 @@
+#include "accel/reference/embree_device.h"
+
+#include <atomic>
+#include <cstring>
+#include <string>
+
+#include "accel/core/error.h"
+
+namespace ab {
+
+namespace {
+std::atomic<int64_t> g_embree_bytes{0};
+
+bool monitor(void*, ssize_t bytes, bool) {
+  g_embree_bytes += bytes;
+  return true;
+}
+}  // namespace
+
+RTCDevice embree_device() {
+  static RTCDevice device = [] {
+    RTCDevice d = rtcNewDevice(nullptr);
+    if (!d) throw InputError("embree: cannot create a device");
+    rtcSetDeviceMemoryMonitorFunction(d, monitor, nullptr);
+    return d;
+  }();
+  return device;
+}
+
+int64_t embree_bytes_in_use() {
+  return g_embree_bytes.load();
+}
+
+EmbreeConfig EmbreeConfig::read(Params& params) {
+  EmbreeConfig c;
+  params.read("quality", c.quality,
+              {{"low", RTC_BUILD_QUALITY_LOW},
+               {"medium", RTC_BUILD_QUALITY_MEDIUM},
+               {"high", RTC_BUILD_QUALITY_HIGH}});
+  return c;
+}
+
+void check_embree_error(const char* what) {
+  if (rtcGetDeviceError(embree_device()) != RTC_ERROR_NONE)
+    throw InputError(std::string("embree: ") + what + " failed");
+}
+
+RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags) {
+  RTCDevice device = embree_device();
+  RTCScene scene = rtcNewScene(device);
+  rtcSetSceneFlags(scene, flags);
+  rtcSetSceneBuildQuality(scene, quality);
+  if (mesh.size() > 0) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(geom, quality);
+    // Embree reads vertex buffers with 16-byte loads: allocated through it, the buffer is padded for that.
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, mesh.vertices.size()));
+    std::memcpy(vertices, mesh.vertices.data(), sizeof(float) * 3 * mesh.vertices.size());
+    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, mesh.size()));
+    std::memcpy(indices, mesh.triangles.data(), sizeof(uint32_t) * 3 * mesh.size());
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(scene, geom, 0);
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(scene);
+  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
+    rtcReleaseScene(scene);
+    throw InputError("embree: mesh build failed");
+  }
+  return scene;
+}
+
+}  // namespace ab

@@ -1,0 +1,71 @@
+// What both Embree adapters (one mesh, a scene of instances) share, written once: the process's one Embree
+// device with its memory monitor, the build quality with its one default, the upload of a triangle mesh as a
+// committed Embree scene, and the conversion of a ray.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <cstdint>
+
+#include "accel/core/mesh.h"
+#include "accel/core/params.h"
+#include "accel/core/ray.h"
+
+namespace ab {
+
+/// The registry name of Embree (the mesh adapter registers under it; a scene uses Embree's own instancing
+/// when both levels are named so).
+inline constexpr const char* kEmbreeName = "embree";
+
+/// The process-wide Embree device (created on first use); its memory monitor counts the bytes Embree holds.
+RTCDevice embree_device();
+/// Bytes Embree currently holds (from the device's memory monitor).
+int64_t embree_bytes_in_use();
+
+/// Embree's configuration: the build quality (RTC_BUILD_QUALITY_*), medium by default for meshes and scenes
+/// alike (the reference every ratio_to_embree is measured against).
+struct EmbreeConfig {
+  RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< quality=low|medium|high
+  /// Reads `quality`.
+  static EmbreeConfig read(Params& params);
+};
+
+/// A committed Embree scene holding `mesh` as geometry 0 (primID = triangle id; no geometry when the mesh is
+/// empty), built at `quality` with `flags`. Throws InputError when Embree reports an error.
+RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags);
+
+/// Throws InputError naming `what` when the device has recorded an error (and clears it).
+void check_embree_error(const char* what);
+
+/// Converts a ray to Embree's RTCRayHit: tnear = tmin, tfar = `tfar` (the ray's tmax, or the best hit so
+/// far), every mask bit, time 0, no hit.
+inline RTCRayHit to_embree(const Ray& r, float tfar) {
+  RTCRayHit rh;
+  rh.ray.org_x = r.org.x;
+  rh.ray.org_y = r.org.y;
+  rh.ray.org_z = r.org.z;
+  rh.ray.dir_x = r.dir.x;
+  rh.ray.dir_y = r.dir.y;
+  rh.ray.dir_z = r.dir.z;
+  rh.ray.tnear = r.tmin;
+  rh.ray.tfar = tfar;
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+/// The same over the whole of the ray's [tmin, tmax].
+inline RTCRayHit to_embree(const Ray& r) {
+  return to_embree(r, r.tmax);
+}
+
+/// True when rtcOccluded1 found a hit (Embree sets tfar to -inf then).
+inline bool embree_occluded(const RTCRay& r) {
+  return r.tfar == -kInf;
+}
+
+}  // namespace ab
