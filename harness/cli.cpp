@@ -1,11 +1,11 @@
 #include "harness/cli.h"
 
-#include "accel/core/error.h"
-#include "accel/core/registry.h"
-
 #include <algorithm>
 #include <iostream>
-#include <sstream>
+
+#include "accel/core/error.h"
+#include "accel/core/registry.h"
+#include "harness/selection.h"
 
 namespace ab {
 
@@ -21,7 +21,9 @@ int fail_input(const std::string& message) {
   return 2;
 }
 
-std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
+std::string first_line(const std::string& s) {
+  return s.substr(0, s.find('\n'));
+}
 }  // namespace
 
 CommandRegistrar::CommandRegistrar(Command command) {
@@ -30,14 +32,14 @@ CommandRegistrar::CommandRegistrar(Command command) {
   std::stable_sort(t.begin(), t.end(), [](const Command& a, const Command& b) { return a.order < b.order; });
 }
 
-const std::vector<Command>& commands() { return command_table(); }
+const std::vector<Command>& commands() {
+  return command_table();
+}
 
 CLI::Validator accelerator_name_validator(bool list) {
   return CLI::Validator(
       [list](std::string& value) -> std::string {
-        std::stringstream names(value);
-        std::string name;
-        while (std::getline(names, name, ',')) {
+        for (const std::string& name : split_list(value)) {
           if (list && name == "all") continue;
           try {
             find_accelerator(name);
@@ -51,7 +53,8 @@ CLI::Validator accelerator_name_validator(bool list) {
 }
 
 int run_cli(int argc, char** argv) {
-  CLI::App app{"accelbench: benchmark and research harness for ray-tracing acceleration structures", "accelbench"};
+  CLI::App app{"accelbench: benchmark and research harness for ray-tracing acceleration structures",
+               "accelbench"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "accelbench 0.1");
   std::vector<std::pair<CLI::App*, std::function<int()>>> actions;

@@ -1,15 +1,15 @@
 // `accelbench list [--json]`: accelerators, mesh generators and ray kinds.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
 #include "accel/core/registry.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/cli.h"
+#include "harness/selection.h"
 #include "tracer/workload.h"
-
-#include <nlohmann/json.hpp>
-
-#include <iomanip>
-#include <iostream>
-#include <memory>
 
 namespace ab {
 namespace {
@@ -18,7 +18,7 @@ nlohmann::json listing() {
   nlohmann::json j;
   j["accelerators"] = nlohmann::json::array();
   for (const auto& a : accelerators()) {
-    if (a.name.rfind("test-", 0) == 0) continue;
+    if (is_test_only(a.name)) continue;
     j["accelerators"].push_back({{"name", a.name},
                                  {"description", a.description},
                                  {"reference", a.is_reference},
@@ -26,9 +26,11 @@ nlohmann::json listing() {
                                  {"params", default_params(a.name)}});
   }
   j["generators"] = nlohmann::json::array();
-  for (const auto& g : generators()) j["generators"].push_back({{"name", g.name}, {"description", g.description}});
+  for (const auto& g : generators())
+    j["generators"].push_back({{"name", g.name}, {"description", g.description}});
   j["ray_kinds"] = nlohmann::json::array();
-  for (const auto& k : ray_kinds()) j["ray_kinds"].push_back({{"name", k.name}, {"description", k.description}});
+  for (const auto& k : ray_kinds())
+    j["ray_kinds"].push_back({{"name", k.name}, {"description", k.description}});
   j["scene_ray_kinds"] = nlohmann::json::array();
   for (const auto& k : scene_ray_kinds())
     j["scene_ray_kinds"].push_back({{"name", k.name}, {"description", k.description}});
@@ -42,8 +44,9 @@ void print_section(const std::string& title, const nlohmann::json& items) {
     std::cout << "  " << std::left << std::setw(16) << item["name"].get<std::string>() << " "
               << item["description"].get<std::string>() << "\n";
     if (!item.contains("params") || item["params"].empty()) continue;
-    std::cout << "  " << std::setw(16) << "" << " params:";
-    for (const auto& [k, v] : item["params"].items()) std::cout << " " << k << "=" << (v.is_string() ? v.get<std::string>() : v.dump());
+    std::cout << std::string(2 + 16 + 1, ' ') << "params:";  // under the description
+    for (const auto& [k, v] : item["params"].items())
+      std::cout << " " << k << "=" << (v.is_string() ? v.get<std::string>() : v.dump());
     std::cout << "\n";
   }
 }
@@ -60,7 +63,8 @@ const CommandRegistrar kList{{"list", "names of accelerators, mesh generators an
                                     print_section("accelerators", j["accelerators"]);
                                     print_section("generators", j["generators"]);
                                     print_section("ray kinds", j["ray_kinds"]);
-                                    print_section("ray kinds for --scene (the tracer's own)", j["scene_ray_kinds"]);
+                                    print_section("ray kinds for --scene (the tracer's own)",
+                                                  j["scene_ray_kinds"]);
                                   }
                                   return 0;
                                 };

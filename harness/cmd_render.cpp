@@ -2,18 +2,18 @@
 //  [--width W] [--height H] [--max-depth D] [--seed S] [--threads T]
 //  [--heatmap [--metric nodes|prims] [--scale-max V]]
 //  [--param k=v ...] -o FILE.png`
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
-#include <iostream>
 #include <memory>
 
 #include "accel/core/error.h"
-#include "accel/core/registry.h"
+#include "accel/reference/embree_device.h"
 #include "harness/cli.h"
 #include "harness/options.h"
+#include "harness/selection.h"
 #include "harness/target.h"
+#include "harness/terminal.h"
+#include "harness/timing.h"
 #include "tracer/heatmap.h"
 #include "tracer/integrator.h"
 #include "tracer/scene.h"
@@ -24,34 +24,14 @@ namespace {
 struct RenderArgs {
   std::string scene;
   std::string accel;
-  std::string accel_top;
-  std::string accel_bottom;
+  StructureOptions structure;
   std::string output;
-  std::vector<std::string> params;
   int spp = 0, width = 0, height = 0, max_depth = 0, threads = 0;
   uint64_t seed = 1;
   bool heatmap = false;
   std::string metric = "nodes";
   float scale_max = 0.0f;
 };
-
-/// The default structure: the project's SAH BVH where it is registered, else brute force.
-std::string default_accelerator() {
-  for (const auto& info : accelerators())
-    if (info.name == "bvh-sah") return info.name;
-  return "brute";
-}
-
-/// A progress bar on stderr, only when stderr is a terminal.
-std::function<void(size_t, size_t)> progress_bar() {
-  if (!isatty(STDERR_FILENO)) return {};
-  return [](size_t done, size_t total) {
-    const int width = 40, filled = int(double(width) * double(done) / double(total));
-    std::fprintf(stderr, "\r[%s%s] %3d%%", std::string(size_t(filled), '#').c_str(),
-                 std::string(size_t(width - filled), ' ').c_str(), int(100.0 * double(done) / double(total)));
-    if (done == total) std::fprintf(stderr, "\n");
-  };
-}
 
 int run_render(const RenderArgs& a) {
   const Target target = load_target("", a.scene);
@@ -63,16 +43,16 @@ int run_render(const RenderArgs& a) {
   if (a.max_depth) opt.max_depth = a.max_depth;
   opt.seed = a.seed;
   opt.threads = a.threads;
-  opt.progress = progress_bar();
-  const std::string name = a.accel.empty() ? default_accelerator() : a.accel;
-  std::unique_ptr<Accelerator> accel =
-      make_target_accelerator(target, name, params_from(a.params), a.accel_top, a.accel_bottom);
+  opt.progress = progress_callback("rendering " + a.output);
+  const std::string name = a.accel.empty() ? default_structure() : a.accel;
+  std::unique_ptr<Accelerator> accel = make_target_accelerator(target, name, params_from(a.structure.params),
+                                                               a.structure.top, a.structure.bottom);
   accel->build();
   const auto start = std::chrono::steady_clock::now();
   RenderCounts counts;
   Image8 out;
   if (a.heatmap) {
-    if (accel->name() == "embree") throw InputError("--heatmap: embree has no traversal counters");
+    if (accel->name() == kEmbreeName) throw InputError("--heatmap: embree has no traversal counters");
     const HeatmapMetric m = a.metric == "prims" ? HeatmapMetric::kPrims : HeatmapMetric::kNodes;
     const std::vector<float> work = render_work(scene, *accel, opt, m);
     out = heatmap_image(work, opt.width, opt.height,
@@ -82,7 +62,7 @@ int run_render(const RenderArgs& a) {
   } else {
     out = to_srgb8(render(scene, *accel, opt, &counts));
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = seconds_since(start);
   write_png(out, a.output);
   std::printf("%s: %dx%d, %d spp, %s: build %.3f s, render %.3f s, %llu rays (%.2f Mrays/s)\n",
               a.output.c_str(), opt.width, opt.height, opt.spp, accel->name().c_str(),
@@ -98,23 +78,19 @@ const CommandRegistrar kRender{
        app.add_option("--scene", a->scene, "scene file (.xml)")->required()->check(CLI::ExistingFile);
        app.add_option("--accel", a->accel, "accelerator at both levels (default bvh-sah)")
            ->check(accelerator_name_validator());
-       app.add_option("--accel-top", a->accel_top, "top-level accelerator")
-           ->check(accelerator_name_validator());
-       app.add_option("--accel-bottom", a->accel_bottom, "per-mesh accelerator")
-           ->check(accelerator_name_validator());
+       a->structure.add(app);
        app.add_option("--spp", a->spp, "samples per pixel (default: the scene's)")
            ->check(CLI::Range(1, 65536));
        app.add_option("--width", a->width, "image width")->check(CLI::Range(1, 16384));
        app.add_option("--height", a->height, "image height")->check(CLI::Range(1, 16384));
        app.add_option("--max-depth", a->max_depth, "recursion limit")->check(CLI::Range(1, 64));
        app.add_option("--seed", a->seed, "random seed");
-       app.add_option("--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
+       add_threads_option(app, a->threads);
        app.add_flag("--heatmap", a->heatmap, "false-colour traversal work per pixel");
        app.add_option("--metric", a->metric, "heatmap metric")->check(CLI::IsMember({"nodes", "prims"}));
        app.add_option("--scale-max", a->scale_max,
                       "heatmap: value at the top of the colour scale (default: the image's maximum)")
            ->check(CLI::PositiveNumber);
-       app.add_option("--param", a->params, "accelerator parameter k=v (repeatable)");
        app.add_option("-o,--output", a->output, "output .png file")->required();
        return [a] { return run_render(*a); };
      }}};

@@ -5,15 +5,16 @@
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 
 #include "accel/core/error.h"
 #include "harness/cli.h"
+#include "harness/machine.h"
 #include "harness/report.h"
 #include "harness/run.h"
 #include "harness/suite.h"
+#include "harness/terminal.h"
 
 namespace ab {
 namespace {
@@ -32,12 +33,7 @@ struct RunArgs {
 };
 
 std::string default_out_dir() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%SZ", &tm);
-  return std::string("results/") + buf;
+  return "results/" + utc_now("%Y%m%dT%H%M%SZ");
 }
 
 /// Runs scripts/plot DIR with Debian's Python when it can import matplotlib; returns whether it drew.
@@ -53,12 +49,11 @@ bool draw_plots(const std::string& dir) {
 }
 
 void print_failures(const nlohmann::json& report, bool color) {
-  const char* red = color ? "\033[1;31m" : "";
-  const char* reset = color ? "\033[0m" : "";
+  const Colors c = colors(color);
   for (const auto& f : report["failures"])
-    std::cout << red << "FAILED: " << f.get<std::string>() << reset << "\n";
+    std::cout << c.red << "FAILED: " << f.get<std::string>() << c.reset << "\n";
   if (!report["verified"].get<bool>())
-    std::cout << red << "run: VERIFICATION FAILED (" << report["failures"].size() << " failures)" << reset
+    std::cout << c.red << "run: VERIFICATION FAILED (" << report["failures"].size() << " failures)" << c.reset
               << "\n";
 }
 

@@ -1,18 +1,19 @@
-// `accelbench verify (--mesh F | --scene F) [--accel all|NAME,...] [--rays FILE.rays | --kind KIND --count N]`
-// Traces with every named accelerator, with brute force and with Embree; prints the agreement table;
-// exit 1 on any hit that differs from brute's, or any disagreement with Embree that is not explained.
-#include "accel/core/registry.h"
-#include "accel/core/trace.h"
+// `accelbench verify (--mesh F | --scene F) [--accel all|NAME,...] [--rays FILE.rays | --kind KIND --count
+// N]` Traces with every named accelerator, with brute force and with Embree; prints the agreement table; exit
+// 1 on any hit that differs from brute's, or any disagreement with Embree that is not explained.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "accel/reference/embree_device.h"
 #include "harness/cli.h"
 #include "harness/compare.h"
 #include "harness/hitfile.h"
 #include "harness/options.h"
+#include "harness/selection.h"
 #include "harness/target.h"
-
-#include <cstdio>
-#include <iostream>
-#include <memory>
-#include <sstream>
+#include "harness/verification.h"
 
 namespace ab {
 namespace {
@@ -27,45 +28,41 @@ struct VerifyArgs {
   int threads = 0;
 };
 
+/// The accelerators to check: "all" (every listed one but Embree, brute force first), or the named ones
+/// with brute force put first when it is not named (Embree is the reference of the agreement columns).
 std::vector<std::string> accelerator_list(const std::string& spec) {
   std::vector<std::string> names;
-  if (spec == "all") {
-    for (const auto& info : accelerators())
-      if (info.name.rfind("test-", 0) != 0 && info.name != "embree") names.push_back(info.name);
-    return names;
+  for (const std::string& name : split_list(spec)) {
+    if (name == "all") return listed_accelerators({kEmbreeName});
+    if (name != kEmbreeName) names.push_back(name);
   }
-  std::stringstream ss(spec);
-  std::string name;
-  while (std::getline(ss, name, ','))
-    if (name == "all") return accelerator_list("all");
-    else if (name != "embree") names.push_back(name);
   if (std::find(names.begin(), names.end(), "brute") == names.end()) names.insert(names.begin(), "brute");
   return names;
 }
 
+/// Builds `name` over the target with its default parameters and traces the rays.
 std::vector<Hit> trace_with(const Target& target, const std::string& name, const std::vector<Ray>& rays,
                             int threads, double& build_seconds) {
-  std::unique_ptr<Accelerator> accel = make_target_accelerator(target, name, Params{});
-  accel->build();
+  const std::unique_ptr<Accelerator> accel = build_default(target, name);
   build_seconds = accel->stats().build_seconds;
-  std::vector<Hit> hits(rays.size());
-  trace_closest(*accel, rays, hits, threads);
-  return hits;
+  return closest_hits(*accel, rays, threads);
 }
 
 int run_verify(const VerifyArgs& a) {
   const Target target = load_target(a.target.mesh, a.target.scene);
   std::vector<Ray> rays;
-  if (!a.rays.empty()) rays = read_rays(a.rays);
-  else rays = make_target_rays(target, a.kind.empty() ? "incoherent" : a.kind, a.count, a.seed);
+  if (!a.rays.empty())
+    rays = read_rays(a.rays);
+  else
+    rays = make_target_rays(target, a.kind.empty() ? "incoherent" : a.kind, a.count, a.seed);
   const HitTriangleFn triangle_of = hit_triangles(target);
   double embree_build = 0.0;
-  const std::vector<Hit> embree = trace_with(target, "embree", rays, a.threads, embree_build);
+  const std::vector<Hit> embree = trace_with(target, kEmbreeName, rays, a.threads, embree_build);
   std::vector<Hit> brute;
   bool failed = false;
   std::printf("%s: %zu triangles, %zu rays\n", target.path.c_str(), size_t(target.triangles), rays.size());
-  std::printf("%-16s %9s  %-22s %9s %7s %7s %7s %7s %11s\n", "accelerator", "build s", "vs brute", "agree", "tie",
-              "edge", "graze", "limit", "unexplained");
+  std::printf("%-16s %9s  %-22s %9s %7s %7s %7s %7s %11s\n", "accelerator", "build s", "vs brute", "agree",
+              "tie", "edge", "graze", "limit", "unexplained");
   for (const std::string& name : accelerator_list(a.accels)) {
     double build = 0.0;
     const std::vector<Hit> hits = trace_with(target, name, rays, a.threads, build);
@@ -82,16 +79,17 @@ int run_verify(const VerifyArgs& a) {
     }
     const Agreement ag = classify_agreement(rays, hits, embree, triangle_of);
     if (ag.unexplained) failed = true;
-    std::printf("%-16s %9.3f  %-22s %9llu %7llu %7llu %7llu %7llu %11llu\n", name.c_str(), build, vs_brute.c_str(),
-                (unsigned long long)ag.agree, (unsigned long long)ag.tie, (unsigned long long)ag.edge,
-                (unsigned long long)ag.graze, (unsigned long long)ag.limit, (unsigned long long)ag.unexplained);
+    std::printf("%-16s %9.3f  %-22s %9llu %7llu %7llu %7llu %7llu %11llu\n", name.c_str(), build,
+                vs_brute.c_str(), (unsigned long long)ag.agree, (unsigned long long)ag.tie,
+                (unsigned long long)ag.edge, (unsigned long long)ag.graze, (unsigned long long)ag.limit,
+                (unsigned long long)ag.unexplained);
     if (ag.unexplained) {
       std::printf("  unexplained disagreements with embree at rays:");
       for (uint64_t i : ag.unexplained_rays) std::printf(" %llu", (unsigned long long)i);
       std::printf("\n");
     }
   }
-  std::printf("%-16s %9.3f  (reference for the agreement columns)\n", "embree", embree_build);
+  std::printf("%-16s %9.3f  (reference for the agreement columns)\n", kEmbreeName, embree_build);
   std::printf(failed ? "verify: FAILED\n" : "verify: all accelerators agree\n");
   return failed ? 1 : 0;
 }
@@ -105,9 +103,10 @@ const CommandRegistrar kVerify{
            ->check(accelerator_name_validator(true));
        auto* rays = app.add_option("--rays", a->rays, "input .rays file")->check(CLI::ExistingFile);
        auto* kind = app.add_option("--kind", a->kind, "ray kind to generate (default incoherent)");
-       app.add_option("--count", a->count, "rays to generate")->check(CLI::Range(uint64_t{1}, uint64_t{100'000'000}));
+       app.add_option("--count", a->count, "rays to generate")
+           ->check(CLI::Range(uint64_t{1}, uint64_t{100'000'000}));
        app.add_option("--seed", a->seed, "random seed for generated rays");
-       app.add_option("--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
+       add_threads_option(app, a->threads);
        rays->excludes(kind);
        return [a] { return run_verify(*a); };
      }}};

@@ -9,6 +9,7 @@
 #include <CLI/Version.hpp>
 #include <array>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <glm/glm.hpp>
@@ -173,6 +174,15 @@ nlohmann::json source_info() {
   const bool dirty = !command_output(git + "status --porcelain --untracked-files=no").empty();
   if (commit.empty()) commit = "unknown";
   return {{"git_commit", commit}, {"git_dirty", dirty}, {"source_dir", dir}};
+}
+
+std::string utc_now(const char* format) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[64];
+  std::strftime(buf, sizeof buf, format, &tm);
+  return buf;
 }
 
 nlohmann::json library_versions() {

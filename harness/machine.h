@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace ab {
 
@@ -15,5 +16,7 @@ nlohmann::json compiler_info();
 nlohmann::json source_info();
 /// Versions of Embree, TBB, nlohmann-json, CLI11, GLM, OpenMesh and pugixml.
 nlohmann::json library_versions();
+/// The current UTC time in a strftime format (for example "%Y-%m-%dT%H:%M:%SZ").
+std::string utc_now(const char* format);
 
 }  // namespace ab

@@ -1,5 +1,7 @@
 #include "harness/options.h"
 
+#include "harness/cli.h"
+
 namespace ab {
 
 void TargetOptions::add(CLI::App& app) {
@@ -11,6 +13,17 @@ void TargetOptions::add(CLI::App& app) {
     if (mesh.empty() && scene.empty()) throw CLI::RequiredError("--mesh or --scene");
     (void)app;
   });
+}
+
+void StructureOptions::add(CLI::App& app) {
+  app.add_option("--accel-top", top, "scenes: top-level accelerator")->check(accelerator_name_validator());
+  app.add_option("--accel-bottom", bottom, "scenes: per-mesh accelerator")
+      ->check(accelerator_name_validator());
+  app.add_option("--param", params, "accelerator parameter k=v (repeatable)");
+}
+
+void add_threads_option(CLI::App& app, int& threads) {
+  app.add_option("--threads", threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
 }
 
 Params params_from(const std::vector<std::string>& kvs) {

@@ -1,7 +1,5 @@
 #include "harness/report.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +10,8 @@
 #include <sstream>
 
 #include "datasets/atomic_file.h"
+#include "harness/analysis.h"
+#include "harness/terminal.h"
 
 namespace ab {
 
@@ -112,57 +112,11 @@ void write_report(const nlohmann::json& report, const std::string& dir) {
 
 namespace {
 
-/// Geometric mean of the positive values (NaN when there are none).
-struct GeoMean {
-  double log_sum = 0.0;
-  int n = 0;
-  void add(const nlohmann::json& v) {
-    if (v.is_number() && v.get<double>() > 0) {
-      log_sum += std::log(v.get<double>());
-      ++n;
-    }
-  }
-  double value() const { return n ? std::exp(log_sum / n) : std::nan(""); }
-};
-
-struct ConfigSummary {
-  GeoMean ratio_one, ratio_all, mrays_one, mrays_all, build_rate, nodes, prims, bytes;
-  bool verified = true;
-  int rows = 0;
-};
-
 std::string fmt(double v, int precision) {
   if (std::isnan(v)) return "-";
   std::ostringstream s;
   s << std::fixed << std::setprecision(precision) << v;
   return s.str();
-}
-
-std::map<std::string, ConfigSummary> summarize(const nlohmann::json& report,
-                                               std::vector<std::string>& order) {
-  std::map<std::string, ConfigSummary> by_config;
-  const int max_threads = report.value("max_threads", 0);
-  for (const auto& row : report.value("results", nlohmann::json::array())) {
-    const std::string label = row.value("config_label", "");
-    if (!by_config.count(label)) order.push_back(label);
-    ConfigSummary& s = by_config[label];
-    ++s.rows;
-    if (!row.value("verified", true)) s.verified = false;
-    s.bytes.add(row.value("bytes_per_triangle", nlohmann::json()));
-    const double build = row.value("build_seconds_median", 0.0);
-    if (build > 0) s.build_rate.add(row.value("triangles", 0.0) / build / 1e6);
-    if (row.value("query", "") != "closest") continue;
-    const bool one = row.value("threads_used", 0) == 1;
-    const bool all = row.value("threads_used", 0) == max_threads;
-    const double mrays = row.value("rays_per_second", 0.0) / 1e6;
-    const nlohmann::json ratio = row.value("ratio_to_embree", nlohmann::json());
-    if (one) s.ratio_one.add(ratio), s.mrays_one.add(mrays);
-    if (all) s.ratio_all.add(ratio), s.mrays_all.add(mrays);
-    if (one)
-      s.nodes.add(row.value("nodes_per_ray", nlohmann::json())),
-          s.prims.add(row.value("prims_per_ray", nlohmann::json()));
-  }
-  return by_config;
 }
 
 void print_verification_line(std::ostream& out, const nlohmann::json& report) {
@@ -196,11 +150,9 @@ void print_correlation_line(std::ostream& out, const nlohmann::json& report) {
 
 void print_summary_table(std::ostream& out, const nlohmann::json& report, bool color) {
   std::vector<std::string> order;
-  const auto by_config = summarize(report, order);
+  const auto by_config = summarize_configs(report, order);
   const int max_threads = report.value("max_threads", 0);
-  const char* red = color ? "\033[1;31m" : "";
-  const char* green = color ? "\033[32m" : "";
-  const char* reset = color ? "\033[0m" : "";
+  const Colors c = colors(color);
   out << "geometric means over scenes and ray sets (closest hit); ratio = rays/s / embree's rays/s in this "
          "run\n";
   out << std::left << std::setw(30) << "accelerator" << std::right << std::setw(9) << "ratio@1"
@@ -215,44 +167,10 @@ void print_summary_table(std::ostream& out, const nlohmann::json& report, bool c
         << fmt(s.mrays_one.value(), 2) << std::setw(10) << fmt(s.mrays_all.value(), 2) << std::setw(11)
         << fmt(s.build_rate.value(), 2) << std::setw(8) << fmt(s.bytes.value(), 1) << std::setw(10)
         << fmt(s.nodes.value(), 1) << std::setw(10) << fmt(s.prims.value(), 1) << "  "
-        << (s.verified ? green : red) << (s.verified ? "ok" : "FAILED") << reset << "\n";
+        << (s.verified ? c.green : c.red) << (s.verified ? "ok" : "FAILED") << c.reset << "\n";
   }
   print_verification_line(out, report);
   print_correlation_line(out, report);
-}
-
-bool stderr_is_terminal() {
-  return ::isatty(2) == 1;
-}
-bool stdout_is_terminal() {
-  return ::isatty(1) == 1;
-}
-
-Progress::Progress(size_t total, bool enabled)
-    : total_(total ? total : 1), enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
-
-void Progress::step(const std::string& what) {
-  ++done_;
-  if (done_ > total_) done_ = total_;
-  draw(what);
-}
-
-void Progress::draw(const std::string& what) {
-  if (!enabled_) return;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  const double frac = double(done_) / double(total_);
-  const double eta = done_ ? elapsed * (1.0 - frac) / frac : 0.0;
-  constexpr int kWidth = 30;
-  const int filled = int(frac * kWidth);
-  char eta_text[32];
-  std::snprintf(eta_text, sizeof eta_text, "%d:%02d", int(eta) / 60, int(eta) % 60);
-  std::cerr << "\r\033[K[" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] "
-            << std::setw(3) << int(frac * 100) << "% ETA " << eta_text << "  " << what.substr(0, 60)
-            << std::flush;
-}
-
-void Progress::finish() {
-  if (enabled_) std::cerr << "\r\033[K" << std::flush;
 }
 
 }  // namespace ab

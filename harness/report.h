@@ -1,8 +1,7 @@
-// The run's report: DIR/report.json (everything), DIR/report.csv (one tidy row per scene x accelerator
-// configuration x ray set x query x threads, the same numbers), the terminal table and the progress bar.
+// The run's report files: DIR/report.json (everything), DIR/report.csv (one tidy row per scene x accelerator
+// configuration x ray set x query x threads, the same numbers), and the table printed at the end.
 #pragma once
 
-#include <chrono>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
@@ -24,28 +23,5 @@ void write_report(const nlohmann::json& report, const std::string& dir);
 /// ratio to Embree at 1 thread and at all threads, Mrays/s, build time, bytes per triangle, per-ray
 /// costs and the verification verdict. `color` adds ANSI colors (red for failures).
 void print_summary_table(std::ostream& out, const nlohmann::json& report, bool color);
-
-/// A progress bar with ETA on stderr, drawn only when stderr is a terminal.
-class Progress {
- public:
-  /// `total` units of work; `enabled` false draws nothing.
-  Progress(size_t total, bool enabled);
-  /// One more unit done; `what` says what is running now.
-  void step(const std::string& what);
-  /// Clears the bar.
-  void finish();
-
- private:
-  void draw(const std::string& what);
-  size_t total_;
-  size_t done_ = 0;
-  bool enabled_;
-  std::chrono::steady_clock::time_point start_;
-};
-
-/// True when stderr is a terminal (progress bar and colors).
-bool stderr_is_terminal();
-/// True when stdout is a terminal.
-bool stdout_is_terminal();
 
 }  // namespace ab

@@ -1,6 +1,7 @@
 // Running a suite: scenes are made one at a time, every accelerator configuration is built (timed over
-// the repetitions), verified against brute force, the verified reference structure and Embree, and
-// timed through Google Benchmark at each thread count; counters come from a separate counting pass.
+// the repetitions), verified against brute force, the verified reference structure and Embree
+// (harness/verification.h), and timed through Google Benchmark at each thread count (harness/timing.h);
+// counters come from a separate counting pass; ratios and correlations follow (harness/analysis.h).
 #pragma once
 
 #include <atomic>
@@ -23,8 +24,5 @@ struct RunOptions {
 /// with gbench.json beside it). report["verified"] is false when any check failed; report["interrupted"]
 /// is true when the run stopped early (finished cases are kept).
 nlohmann::json run_suite(const Suite& suite, const RunOptions& options);
-
-/// Pearson's correlation coefficient of two equally long series (NaN when undefined).
-double pearson(const std::vector<double>& x, const std::vector<double>& y);
 
 }  // namespace ab

@@ -1,7 +1,5 @@
 #include "harness/suite.h"
 
-#include "tracer/workload.h"
-
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +11,8 @@
 #include "accel/core/registry.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
+#include "harness/selection.h"
+#include "tracer/workload.h"
 
 namespace ab {
 
@@ -55,6 +55,11 @@ uint64_t read_count(const json& j, const Where& w, uint64_t lo, uint64_t hi) {
 std::string read_string(const json& j, const Where& w) {
   if (!j.is_string() || j.get<std::string>().empty()) w.fail("expected a non-empty string, got " + j.dump());
   return j.get<std::string>();
+}
+
+bool read_bool(const json& j, const Where& w) {
+  if (!j.is_boolean()) w.fail("expected true or false");
+  return j.get<bool>();
 }
 
 /// A parameter value as the k=v string the structures parse.
@@ -166,13 +171,10 @@ std::vector<SceneSpec> parse_scenes(const json& j, const Where& w, const std::st
   return out;
 }
 
-/// Names "all" stands for: every registered accelerator but brute (too slow to time on real sizes; it
-/// is the verification reference) and test-only ones.
+/// Names "all" stands for: every listed accelerator but brute (too slow to time on real sizes; it is the
+/// verification reference).
 std::vector<std::string> all_accelerator_names() {
-  std::vector<std::string> names;
-  for (const auto& info : accelerators())
-    if (info.name != "brute" && info.name.rfind("test-", 0) != 0) names.push_back(info.name);
-  return names;
+  return listed_accelerators({"brute"});
 }
 
 std::vector<AccelSpec> parse_accelerators(const json& j, const Where& w) {
@@ -219,10 +221,7 @@ std::vector<RaySpec> parse_rays(const json& j, const Where& w, const std::string
       spec.path = resolve(read_string(j[i]["file"], wi.at("file")), base_dir);
       spec.label = "file:" + std::filesystem::path(spec.path).filename().string();
     }
-    if (j[i].contains("any_hit")) {
-      if (!j[i]["any_hit"].is_boolean()) wi.at("any_hit").fail("expected true or false");
-      spec.any_hit = j[i]["any_hit"].get<bool>();
-    }
+    if (j[i].contains("any_hit")) spec.any_hit = read_bool(j[i]["any_hit"], wi.at("any_hit"));
     if (j[i].contains("label")) spec.label = read_string(j[i]["label"], wi.at("label"));
     out.push_back(std::move(spec));
   }
@@ -241,10 +240,7 @@ VerifySpec parse_verify(const json& j, const Where& w) {
   VerifySpec v;
   if (j.contains("brute_rays")) v.brute_rays = read_count(j["brute_rays"], w.at("brute_rays"), 0, 1ull << 30);
   if (j.contains("reference")) v.reference = read_string(j["reference"], w.at("reference"));
-  if (j.contains("embree")) {
-    if (!j["embree"].is_boolean()) w.at("embree").fail("expected true or false");
-    v.embree = j["embree"].get<bool>();
-  }
+  if (j.contains("embree")) v.embree = read_bool(j["embree"], w.at("embree"));
   return v;
 }
 
@@ -270,10 +266,7 @@ void parse_settings(const json& j, const Where& w, Suite& suite) {
       w.at("min_time").fail("expected a number of seconds in [0, 60]");
     suite.min_time = j["min_time"].get<double>();
   }
-  if (j.contains("build_only")) {
-    if (!j["build_only"].is_boolean()) w.at("build_only").fail("expected true or false");
-    suite.build_only = j["build_only"].get<bool>();
-  }
+  if (j.contains("build_only")) suite.build_only = read_bool(j["build_only"], w.at("build_only"));
   if (j.contains("threads")) suite.threads = parse_threads(j["threads"], w.at("threads"));
   if (j.contains("verify")) suite.verify = parse_verify(j["verify"], w.at("verify"));
 }
@@ -415,7 +408,8 @@ void validate_scenes(const Suite& suite) {
 
 void validate_rays(const Suite& suite) {
   const auto& kinds = ray_kinds();
-  // The tracer's own kinds (dof, glossy, ...) need a camera and lights: only when every scene is a scene file.
+  // The tracer's own kinds (dof, glossy, ...) need a camera and lights: only when every scene is a scene
+  // file.
   const bool all_scene_files = std::all_of(suite.scenes.begin(), suite.scenes.end(), [](const SceneSpec& s) {
     return s.source == SceneSpec::Source::kScene;
   });
@@ -424,8 +418,9 @@ void validate_rays(const Suite& suite) {
     const bool mesh_kind =
         std::any_of(kinds.begin(), kinds.end(), [&](const RayKindInfo& k) { return k.name == r.kind; });
     if (!r.kind.empty() && !mesh_kind && !(all_scene_files && is_scene_ray_kind(r.kind)))
-      w.at("kind").fail("unknown ray kind '" + r.kind + "'" +
-                        (is_scene_ray_kind(r.kind) ? " for meshes (it needs every scene to be a scene file)" : ""));
+      w.at("kind").fail(
+          "unknown ray kind '" + r.kind + "'" +
+          (is_scene_ray_kind(r.kind) ? " for meshes (it needs every scene to be a scene file)" : ""));
     if (!r.path.empty() && !std::filesystem::is_regular_file(r.path))
       w.at("file").fail(r.path + ": no such file");
   }

@@ -3,6 +3,7 @@
 #include "accel/core/error.h"
 #include "accel/core/registry.h"
 #include "datasets/mesh_io.h"
+#include "harness/selection.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"
 #include "tracer/workload.h"
@@ -32,8 +33,9 @@ Target load_target(const std::string& mesh_path, const std::string& scene_path) 
   return mesh_target(std::make_shared<const Mesh>(read_mesh(mesh_path)), mesh_path);
 }
 
-std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name, Params params,
-                                                     const std::string& top, const std::string& bottom) {
+std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name,
+                                                     Params params, const std::string& top,
+                                                     const std::string& bottom) {
   if (target.scene) return make_scene_accelerator(target.scene, name, std::move(params), top, bottom);
   if (!top.empty() || !bottom.empty())
     throw InputError("--accel-top and --accel-bottom apply to scenes only (" + target.path + " is a mesh)");
@@ -41,17 +43,16 @@ std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const
 }
 
 namespace {
-/// The structure used to find surface points when making rays: the project's own SAH BVH where it is
-/// registered (deterministic, identical to brute), else brute force.
-std::string ray_generation_accelerator() {
-  for (const auto& info : accelerators())
-    if (info.name == "bvh-sah") return info.name;
-  return "brute";
+/// n scaled to unit length (+z when it has none: a degenerate triangle).
+vec3 unit_or_z(const vec3& n) {
+  const float len = glm::length(n);
+  return len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
 }
 }  // namespace
 
 RayTarget ray_target(const Target& target) {
-  std::unique_ptr<Accelerator> built = make_target_accelerator(target, ray_generation_accelerator(), Params{});
+  // The structure that finds surface points: default_structure(), deterministic and identical to brute.
+  std::unique_ptr<Accelerator> built = make_target_accelerator(target, default_structure(), Params{});
   built->build();
   std::shared_ptr<const Accelerator> accel = std::move(built);
   RayTarget rt;
@@ -59,30 +60,26 @@ RayTarget ray_target(const Target& target) {
   rt.trace = [accel](std::span<const Ray> rays, std::span<Hit> hits) { accel->intersect(rays, hits); };
   if (target.scene) {
     const std::shared_ptr<const Scene> scene = target.scene;
-    rt.normal = [scene](const Hit& h) {
-      const vec3 n = scene->hit_normal(h);
-      const float len = glm::length(n);
-      return len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
-    };
+    rt.normal = [scene](const Hit& h) { return unit_or_z(scene->hit_normal(h)); };
     return rt;
   }
   const std::shared_ptr<const Mesh> mesh = target.mesh;
   rt.normal = [mesh](const Hit& h) {
     const Triangle t = mesh->triangle(h.prim);
-    const vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
-    const float len = glm::length(n);
-    return len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
+    return unit_or_z(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
   };
   return rt;
 }
 
-std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count, uint64_t seed) {
+std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count,
+                                  uint64_t seed) {
   return make_target_rays(target, ray_target(target), kind, count, seed);
 }
 
-std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind, uint64_t count,
-                                  uint64_t seed) {
-  if (target.scene && is_scene_ray_kind(kind)) return make_scene_rays(*target.scene, rt.trace, kind, count, seed);
+std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind,
+                                  uint64_t count, uint64_t seed) {
+  if (target.scene && is_scene_ray_kind(kind))
+    return make_scene_rays(*target.scene, rt.trace, kind, count, seed);
   return make_rays(kind, rt, count, seed);
 }
 

@@ -12,9 +12,9 @@
 #include "accel/core/error.h"
 #include "accel/core/registry.h"
 #include "datasets/generators.h"
+#include "harness/analysis.h"
 #include "harness/bench.h"
 #include "harness/report.h"
-#include "harness/run.h"
 
 namespace ab {
 namespace {

@@ -1,0 +1,114 @@
+#include "harness/analysis.h"
+
+#include <cmath>
+#include <utility>
+
+#include "accel/reference/embree_device.h"
+
+namespace ab {
+
+using nlohmann::json;
+
+double pearson(const std::vector<double>& x, const std::vector<double>& y) {
+  const size_t n = std::min(x.size(), y.size());
+  if (n < 2) return std::nan("");
+  double mx = 0, my = 0;
+  for (size_t i = 0; i < n; ++i) mx += x[i], my += y[i];
+  mx /= double(n);
+  my /= double(n);
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = 0; i < n; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+    syy += (y[i] - my) * (y[i] - my);
+  }
+  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : std::nan("");
+}
+
+void fill_ratios(json& report) {
+  std::map<std::string, double> embree;
+  auto key = [](const json& r) {
+    return r.value("scene", "") + "\n" + r.value("rays", "") + "\n" + r.value("query", "") + "\n" +
+           std::to_string(r.value("threads", -1));
+  };
+  for (const json& r : report["results"])
+    if (r.value("accelerator", "") == kEmbreeName && r.contains("rays_per_second") && !embree.count(key(r)))
+      embree[key(r)] = r["rays_per_second"].get<double>();
+  for (json& r : report["results"]) {
+    const auto it = embree.find(key(r));
+    if (r.contains("rays_per_second") && it != embree.end() && it->second > 0)
+      r["ratio_to_embree"] = r["rays_per_second"].get<double>() / it->second;
+  }
+}
+
+// Havran 2000 ("Heuristic Ray Shooting Algorithms", PhD thesis, ch. 2) judges structures by
+// hardware-independent counts: traversal steps and intersection tests per ray, combined with the same
+// costs the surface area heuristic (Goldsmith and Salmon 1987; MacDonald and Booth 1990) predicts with.
+// The correlation is Pearson's product-moment coefficient.
+void fill_correlations(json& report, int threads) {
+  std::map<std::pair<std::string, std::string>, json> groups;
+  for (const json& r : report["results"]) {
+    if (r.value("query", "") != "closest" || r.value("threads", -1) != threads) continue;
+    if (!r["sah_cost"].is_number() || !r.contains("havran_cost_per_ray")) continue;
+    json& g = groups[{r["scene"], r["rays"]}];
+    g["points"].push_back({{"config_label", r["config_label"]},
+                           {"sah_cost", r["sah_cost"]},
+                           {"havran_cost_per_ray", r["havran_cost_per_ray"]}});
+  }
+  report["sah_correlation"] = json::array();
+  for (auto& [k, g] : groups) {
+    std::vector<double> x, y;
+    for (const json& p : g["points"]) x.push_back(p["sah_cost"]), y.push_back(p["havran_cost_per_ray"]);
+    const double r = x.size() >= 3 ? pearson(x, y) : std::nan("");
+    report["sah_correlation"].push_back({{"scene", k.first},
+                                         {"rays", k.second},
+                                         {"configurations", x.size()},
+                                         {"pearson", std::isnan(r) ? json() : json(r)},
+                                         {"points", g["points"]}});
+  }
+}
+
+void GeoMean::add(const json& v) {
+  if (v.is_number() && v.get<double>() > 0) {
+    log_sum += std::log(v.get<double>());
+    ++n;
+  }
+}
+
+double GeoMean::value() const {
+  return n ? std::exp(log_sum / n) : std::nan("");
+}
+
+namespace {
+
+/// Adds one result row to its configuration's summary.
+void add_row(ConfigSummary& s, const json& row, int max_threads) {
+  ++s.rows;
+  if (!row.value("verified", true)) s.verified = false;
+  s.bytes.add(row.value("bytes_per_triangle", json()));
+  const double build = row.value("build_seconds_median", 0.0);
+  if (build > 0) s.build_rate.add(row.value("triangles", 0.0) / build / 1e6);
+  if (row.value("query", "") != "closest") return;
+  const bool one = row.value("threads_used", 0) == 1;
+  const bool all = row.value("threads_used", 0) == max_threads;
+  const double mrays = row.value("rays_per_second", 0.0) / 1e6;
+  const json ratio = row.value("ratio_to_embree", json());
+  if (one) s.ratio_one.add(ratio), s.mrays_one.add(mrays);
+  if (all) s.ratio_all.add(ratio), s.mrays_all.add(mrays);
+  if (one) s.nodes.add(row.value("nodes_per_ray", json())), s.prims.add(row.value("prims_per_ray", json()));
+}
+
+}  // namespace
+
+std::map<std::string, ConfigSummary> summarize_configs(const json& report, std::vector<std::string>& order) {
+  std::map<std::string, ConfigSummary> by_config;
+  const int max_threads = report.value("max_threads", 0);
+  for (const auto& row : report.value("results", json::array())) {
+    const std::string label = row.value("config_label", "");
+    if (!by_config.count(label)) order.push_back(label);
+    add_row(by_config[label], row, max_threads);
+  }
+  return by_config;
+}
+
+}  // namespace ab
