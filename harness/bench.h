@@ -16,12 +16,12 @@ namespace ab {
 
 /// Seconds per pass over the repetitions of one case.
 struct Timing {
-  double median = 0.0;
-  double min = 0.0;
-  double max = 0.0;
-  double mean = 0.0;
-  double stddev = 0.0;
-  int repetitions = 0;
+  double median = 0.0;     ///< median over the repetitions
+  double min = 0.0;        ///< fastest repetition
+  double max = 0.0;        ///< slowest repetition
+  double mean = 0.0;       ///< mean over the repetitions
+  double stddev = 0.0;     ///< standard deviation over the repetitions
+  int repetitions = 0;     ///< repetitions timed
   int64_t iterations = 0;  ///< passes per repetition
 };
 
@@ -32,6 +32,7 @@ int64_t iterations_for(double pass_seconds, double min_time);
 /// and keeps every reported run.
 class BenchTimer {
  public:
+  /// Initializes Google Benchmark (once per process) and an empty collection of runs.
   BenchTimer();
   ~BenchTimer();
   BenchTimer(const BenchTimer&) = delete;

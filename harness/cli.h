@@ -2,7 +2,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <string>
 #include <vector>
@@ -13,14 +12,15 @@ namespace ab {
 /// returns the action to run after parsing; the action returns the exit code (0, 1 or 2) and may throw
 /// InputError (printed as one line, exit 2).
 struct Command {
-  std::string name;
-  std::string description;
-  int order = 100;  ///< position in --help
+  std::string name;         ///< the subcommand's word
+  std::string description;  ///< one line for --help
+  int order = 100;          ///< position in --help
   std::function<std::function<int()>(CLI::App& app)> setup;
 };
 
 /// Registers a command at static-initialization time.
 struct CommandRegistrar {
+  /// Adds `command` to the table, in order.
   explicit CommandRegistrar(Command command);
 };
 

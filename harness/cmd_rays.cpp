@@ -1,11 +1,11 @@
 // `accelbench rays (--mesh F | --scene F) --kind KIND --count N [--seed S] -o FILE.rays`
+#include <memory>
+
 #include "datasets/rays.h"
 #include "harness/cli.h"
 #include "harness/hitfile.h"
 #include "harness/options.h"
 #include "harness/target.h"
-
-#include <memory>
 
 namespace ab {
 namespace {
@@ -18,23 +18,24 @@ struct RaysArgs {
   std::string output;
 };
 
-const CommandRegistrar kRays{{"rays", "write a ray set (.rays)", 30, [](CLI::App& app) -> std::function<int()> {
-                                auto a = std::make_shared<RaysArgs>();
-                                a->target.add(app);
-                                app.add_option("--kind", a->kind, "ray kind (see list)")->required();
-                                app.add_option("--count", a->count, "number of rays")
-                                    ->required()
-                                    ->check(CLI::Range(uint64_t{0}, uint64_t{1'000'000'000}));
-                                app.add_option("--seed", a->seed, "random seed");
-                                app.add_option("-o,--output", a->output, "output .rays file")->required();
-                                return [a] {
-                                  const Target target = load_target(a->target.mesh, a->target.scene);
-                                  // Scenes: the tracer's own kinds (camera and lights of the scene).
-                                  const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed);
-                                  write_rays(a->output, rays);
-                                  return 0;
-                                };
-                              }}};
+const CommandRegistrar kRays{
+    {"rays", "write a ray set (.rays)", 30, [](CLI::App& app) -> std::function<int()> {
+       auto a = std::make_shared<RaysArgs>();
+       a->target.add(app);
+       app.add_option("--kind", a->kind, "ray kind (see list)")->required();
+       app.add_option("--count", a->count, "number of rays")
+           ->required()
+           ->check(CLI::Range(uint64_t{0}, uint64_t{1'000'000'000}));
+       app.add_option("--seed", a->seed, "random seed");
+       app.add_option("-o,--output", a->output, "output .rays file")->required();
+       return [a] {
+         const Target target = load_target(a->target.mesh, a->target.scene);
+         // Scenes: the tracer's own kinds (camera and lights of the scene).
+         const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed);
+         write_rays(a->output, rays);
+         return 0;
+       };
+     }}};
 
 }  // namespace
 }  // namespace ab

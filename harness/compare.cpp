@@ -25,7 +25,9 @@ constexpr float kEdgeTolerance = 1e-4f;
 constexpr float kEdgeDistance = 1e-5f;
 constexpr float kGrazeCosine = 1e-3f;
 
-bool close_t(float a, float b) { return std::fabs(a - b) <= kTieTolerance * std::max({1.0f, std::fabs(a), std::fabs(b)}); }
+bool close_t(float a, float b) {
+  return std::fabs(a - b) <= kTieTolerance * std::max({1.0f, std::fabs(a), std::fabs(b)});
+}
 
 /// Largest absolute coordinate of the triangle's vertices and the ray's origin (the scale of the kernel's
 /// rounding).
@@ -45,7 +47,8 @@ bool near_edge(const Ray& ray, const Hit& h, const HitTriangleFn& triangle_of) {
   if (h.u <= kEdgeTolerance || h.v <= kEdgeTolerance || w <= kEdgeTolerance) return true;
   const Triangle tri = triangle_of(h);
   const float twice_area = glm::length(glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
-  const float opposite[3] = {glm::length(tri.v2 - tri.v1), glm::length(tri.v0 - tri.v2), glm::length(tri.v1 - tri.v0)};
+  const float opposite[3] = {glm::length(tri.v2 - tri.v1), glm::length(tri.v0 - tri.v2),
+                             glm::length(tri.v1 - tri.v0)};
   const float weight[3] = {w, h.u, h.v};
   const float tolerance = kEdgeDistance * coordinate_scale(ray, tri);
   for (int k = 0; k < 3; ++k)
@@ -70,8 +73,8 @@ bool near_limit(const Ray& ray, const Hit& h) {
 
 }  // namespace
 
-Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours, std::span<const Hit> theirs,
-                             const HitTriangleFn& triangle_of) {
+Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours,
+                             std::span<const Hit> theirs, const HitTriangleFn& triangle_of) {
   Agreement a;
   for (size_t i = 0; i < rays.size(); ++i) {
     const Hit& x = ours[i];
@@ -104,8 +107,12 @@ nlohmann::json to_json(const IdenticalResult& r) {
 }
 
 nlohmann::json to_json(const Agreement& a) {
-  return {{"agree", a.agree}, {"tie", a.tie},     {"edge", a.edge},
-          {"graze", a.graze}, {"limit", a.limit}, {"unexplained", a.unexplained},
+  return {{"agree", a.agree},
+          {"tie", a.tie},
+          {"edge", a.edge},
+          {"graze", a.graze},
+          {"limit", a.limit},
+          {"unexplained", a.unexplained},
           {"unexplained_rays", a.unexplained_rays}};
 }
 

@@ -1,12 +1,12 @@
 #include "harness/hitfile.h"
 
-#include "accel/core/error.h"
-#include "datasets/atomic_file.h"
-
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+
+#include "accel/core/error.h"
+#include "datasets/atomic_file.h"
 
 namespace ab {
 
@@ -22,7 +22,8 @@ std::vector<Record> read_records(const std::string& path, const char (&magic)[9]
   if (!in.read(head, 8)) throw InputError(path + ": file too short for the magic number");
   if (std::memcmp(head, magic, 8) != 0) throw InputError(path + ": wrong magic (expected " + magic + ")");
   uint64_t count = 0;
-  if (!in.read(reinterpret_cast<char*>(&count), 8)) throw InputError(path + ": file too short for the record count");
+  if (!in.read(reinterpret_cast<char*>(&count), 8))
+    throw InputError(path + ": file too short for the record count");
   in.seekg(0, std::ios::end);
   const uint64_t size = static_cast<uint64_t>(in.tellg());
   const uint64_t body = size - 16;
@@ -46,11 +47,14 @@ void write_records(const std::string& path, const char (&magic)[9], const std::v
     out.write(magic, 8);
     const uint64_t count = records.size();
     out.write(reinterpret_cast<const char*>(&count), 8);
-    out.write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>(count * sizeof(Record)));
+    out.write(reinterpret_cast<const char*>(records.data()),
+              static_cast<std::streamsize>(count * sizeof(Record)));
   });
 }
 
-bool finite3(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite3(const vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 }  // namespace
 
@@ -64,10 +68,16 @@ std::vector<Ray> read_rays(const std::string& path) {
   return rays;
 }
 
-void write_rays(const std::string& path, const std::vector<Ray>& rays) { write_records(path, "ABRAYS01", rays); }
+void write_rays(const std::string& path, const std::vector<Ray>& rays) {
+  write_records(path, "ABRAYS01", rays);
+}
 
-std::vector<Hit> read_hits(const std::string& path) { return read_records<Hit>(path, "ABHITS01"); }
+std::vector<Hit> read_hits(const std::string& path) {
+  return read_records<Hit>(path, "ABHITS01");
+}
 
-void write_hits(const std::string& path, const std::vector<Hit>& hits) { write_records(path, "ABHITS01", hits); }
+void write_hits(const std::string& path, const std::vector<Hit>& hits) {
+  write_records(path, "ABHITS01", hits);
+}
 
 }  // namespace ab

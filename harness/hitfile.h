@@ -1,10 +1,10 @@
 // The .rays and .hits files of the contract (little-endian, fixed-size records).
 #pragma once
 
-#include "accel/core/aabb.h"
-
 #include <string>
 #include <vector>
+
+#include "accel/core/aabb.h"
 
 namespace ab {
 

@@ -13,7 +13,7 @@ namespace ab {
 struct SceneSpec {
   /// Where the geometry comes from.
   enum class Source { kGenerator, kMesh, kScene };
-  Source source = Source::kGenerator;
+  Source source = Source::kGenerator;         ///< generator, mesh file or scene file
   std::string label;                          ///< unique name in reports (for example "sphere-10000")
   std::string generator;                      ///< generator name (kGenerator)
   uint64_t triangles = 0;                     ///< requested triangle count (kGenerator)
@@ -25,16 +25,16 @@ struct SceneSpec {
 
 /// One accelerator configuration: a name and one value per parameter (grids are already expanded).
 struct AccelSpec {
-  std::string name;
-  std::map<std::string, std::string> params;
+  std::string name;                           ///< registered accelerator name
+  std::map<std::string, std::string> params;  ///< one value per parameter
   std::string label;  ///< name plus parameters, unique in the suite ("grid{lambda=4}")
   std::string field;  ///< "accelerators[1]"
 };
 
 /// One ray set: a kind and a count, or a .rays file.
 struct RaySpec {
-  std::string kind;  ///< ray kind (empty for a file)
-  uint64_t count = 0;
+  std::string kind;      ///< ray kind (empty for a file)
+  uint64_t count = 0;    ///< rays to make (kind)
   std::string path;      ///< .rays file, resolved against the suite's folder
   bool any_hit = false;  ///< also time any-hit (occlusion) queries; default true for kind "shadow"
   std::string label;     ///< unique name in reports ("primary", "shadow", "file:foo.rays")
@@ -44,27 +44,27 @@ struct RaySpec {
 /// How results are verified.
 struct VerifySpec {
   uint64_t brute_rays = 2000;  ///< rays of each set checked against brute (0: all rays)
-  std::string reference =
-      "bvh-sah";       ///< structure (default config) checked against brute, then used for all rays
+  /// Structure (default config) checked against brute, then used for all rays.
+  std::string reference = "bvh-sah";
   bool embree = true;  ///< classify each structure's hits against Embree when it is registered
 };
 
 /// A whole suite after parsing, with defaults filled in and parameter grids expanded.
 struct Suite {
-  std::string name = "suite";
-  std::string source;   ///< file name (or "default suite") used in error messages and reports
-  nlohmann::json json;  ///< the suite as given
-  std::vector<SceneSpec> scenes;
-  std::vector<AccelSpec> accelerators;
-  std::vector<RaySpec> rays;
-  std::vector<int> threads{1, 0};  ///< 0 = all hardware threads
-  int repetitions = 3;             ///< timed repetitions (median, min and max over them)
-  int build_repetitions = 3;       ///< builds per scene x configuration (default: repetitions)
-  int warmup = 1;                  ///< untimed passes before timing
+  std::string name = "suite";           ///< the suite's name in reports
+  std::string source;                   ///< file name (or "default suite") used in error messages and reports
+  nlohmann::json json;                  ///< the suite as given
+  std::vector<SceneSpec> scenes;        ///< in order
+  std::vector<AccelSpec> accelerators;  ///< configurations, grids expanded
+  std::vector<RaySpec> rays;            ///< ray sets made on every scene
+  std::vector<int> threads{1, 0};       ///< 0 = all hardware threads
+  int repetitions = 3;                  ///< timed repetitions (median, min and max over them)
+  int build_repetitions = 3;            ///< builds per scene x configuration (default: repetitions)
+  int warmup = 1;                       ///< untimed passes before timing
   double min_time = 0.02;   ///< seconds each timed repetition lasts at least (more iterations if faster)
   uint64_t seed = 1;        ///< seed of the ray sets
   bool build_only = false;  ///< measure builds only (no ray sets)
-  VerifySpec verify;
+  VerifySpec verify;        ///< how results are verified
 };
 
 /// Parses a suite. `source` names it in errors; relative paths are resolved against `base_dir`.

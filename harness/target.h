@@ -1,14 +1,14 @@
 // What the CLI traces: a mesh file or a scene file, loaded once, with the structures built over it.
 #pragma once
 
+#include <memory>
+#include <string>
+
 #include "accel/core/accelerator.h"
 #include "accel/core/mesh.h"
 #include "accel/core/params.h"
 #include "datasets/rays.h"
 #include "harness/compare.h"
-
-#include <memory>
-#include <string>
 
 namespace ab {
 
@@ -16,11 +16,11 @@ struct Scene;  // tracer/scene.h
 
 /// A loaded mesh (plain triangles, inst = 0xFFFFFFFF) or scene (instances).
 struct Target {
-  std::string path;
+  std::string path;                    ///< the file (or the name of an in-memory mesh)
   std::shared_ptr<const Mesh> mesh;    ///< set for a mesh
   std::shared_ptr<const Scene> scene;  ///< set for a scene
   uint64_t triangles = 0;              ///< triangles (for a scene: world-space triangles over all instances)
-  AABB bounds;
+  AABB bounds;                         ///< world bounds
 };
 
 /// Loads --mesh F or --scene F (exactly one non-empty). Throws InputError naming the file.
@@ -30,16 +30,18 @@ Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name);
 
 /// Creates (not builds) accelerator `name` over the target. For a scene, `name` serves at both levels
 /// unless `top` or `bottom` is given. Throws InputError / ParamError / UnknownAccelerator.
-std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name, Params params,
-                                                     const std::string& top = "", const std::string& bottom = "");
+std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const std::string& name,
+                                                     Params params, const std::string& top = "",
+                                                     const std::string& bottom = "");
 
 /// Exactly `count` rays of `kind` for the target: for a scene, the tracer's kinds (primary, dof, shadow,
 /// glossy, diffuse: tracer/workload.h) use its camera and lights; every other kind (and every kind for
 /// a mesh) comes from make_rays. Throws InputError for an unknown kind.
-std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count, uint64_t seed);
-/// The same with a RayTarget already made by ray_target(target) (so several ray sets share one build).
-std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind, uint64_t count,
+std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count,
                                   uint64_t seed);
+/// The same with a RayTarget already made by ray_target(target) (so several ray sets share one build).
+std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind,
+                                  uint64_t count, uint64_t seed);
 
 /// What ray generation needs of the target (bounds, a closest-hit trace through a fast structure of the
 /// project, normals at hits).

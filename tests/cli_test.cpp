@@ -1,18 +1,17 @@
 // The CLI's contract, run through the real binary: exit codes, one clear line for bad input, no
 // half-written output, byte-identical hit files across thread counts, and trace --stats.
-#include "harness/hitfile.h"
-
-#include <nlohmann/json.hpp>
-
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
-#include <sys/wait.h>
+
+#include "harness/hitfile.h"
 
 namespace ab {
 namespace {
@@ -38,9 +37,8 @@ class Cli : public ::testing::Test {
     const char* bin = std::getenv("ACCELBENCH_BIN");
     bin_ = bin ? bin : "build/accelbench";
     if (!fs::exists(bin_)) GTEST_SKIP() << "accelbench binary not found at " << bin_;
-    dir_ = fs::temp_directory_path() /
-           ("accelbench_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("accelbench_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -88,15 +86,17 @@ TEST_F(Cli, GenerateRaysTraceRoundTripIsDeterministic) {
   ASSERT_EQ(run("generate sphereflake --triangles 2000 --seed 3 -o " + path("a.obj")).code, 0);
   ASSERT_EQ(run("generate sphereflake --triangles 2000 --seed 3 -o " + path("b.obj")).code, 0);
   EXPECT_EQ(slurp(path("a.obj")), slurp(path("b.obj")));
-  ASSERT_EQ(run("rays --mesh " + path("a.obj") + " --kind primary --count 3000 -o " + path("r.rays")).code, 0);
+  ASSERT_EQ(run("rays --mesh " + path("a.obj") + " --kind primary --count 3000 -o " + path("r.rays")).code,
+            0);
   EXPECT_EQ(read_rays(path("r.rays")).size(), 3000u);
   const std::string base = "trace --mesh " + path("a.obj") + " --rays " + path("r.rays");
   ASSERT_EQ(run(base + " --accel brute --threads 1 -o " + path("b1.hits")).code, 0);
-  ASSERT_EQ(run(base + " --accel brute --threads 2 -o " + path("b2.hits") + " --stats " + path("s.json")).code, 0);
+  ASSERT_EQ(
+      run(base + " --accel brute --threads 2 -o " + path("b2.hits") + " --stats " + path("s.json")).code, 0);
   EXPECT_EQ(slurp(path("b1.hits")), slurp(path("b2.hits")));
   const auto stats = nlohmann::json::parse(slurp(path("s.json")));
-  for (const char* key : {"accelerator", "params", "triangles", "build_seconds", "trace_seconds", "rays_per_second",
-                          "per_ray"})
+  for (const char* key :
+       {"accelerator", "params", "triangles", "build_seconds", "trace_seconds", "rays_per_second", "per_ray"})
     EXPECT_TRUE(stats.contains(key)) << key;
   EXPECT_EQ(stats["per_ray"]["nodes_per_ray"], 0.0);  // brute visits no nodes
   EXPECT_GT(stats["per_ray"]["prims_per_ray"].get<double>(), 1000.0);
@@ -104,7 +104,8 @@ TEST_F(Cli, GenerateRaysTraceRoundTripIsDeterministic) {
 
 TEST_F(Cli, BadInputGivesExitTwoOneLineAndNoOutput) {
   ASSERT_EQ(run("generate soup --triangles 100 -o " + path("m.obj")).code, 0);
-  ASSERT_EQ(run("rays --mesh " + path("m.obj") + " --kind incoherent --count 10 -o " + path("r.rays")).code, 0);
+  ASSERT_EQ(run("rays --mesh " + path("m.obj") + " --kind incoherent --count 10 -o " + path("r.rays")).code,
+            0);
   const std::string good_rays = slurp(path("r.rays"));
   auto write = [&](const std::string& name, const std::string& bytes) {
     std::ofstream(path(name), std::ios::binary) << bytes;
@@ -112,27 +113,33 @@ TEST_F(Cli, BadInputGivesExitTwoOneLineAndNoOutput) {
   const std::string mesh = " --mesh " + path("m.obj");
   const std::string out = path("out.hits");
 
-  expect_bad_input(run("trace --mesh " + path("missing.obj") + " --accel brute --rays " + path("r.rays") + " -o " + out),
-                   "missing.obj");
+  expect_bad_input(
+      run("trace --mesh " + path("missing.obj") + " --accel brute --rays " + path("r.rays") + " -o " + out),
+      "missing.obj");
   write("magic.rays", "XXRAYS01" + good_rays.substr(8));
-  expect_bad_input(run("trace" + mesh + " --accel brute --rays " + path("magic.rays") + " -o " + out), "magic.rays");
+  expect_bad_input(run("trace" + mesh + " --accel brute --rays " + path("magic.rays") + " -o " + out),
+                   "magic.rays");
   write("short.rays", good_rays.substr(0, good_rays.size() - 5));
-  expect_bad_input(run("trace" + mesh + " --accel brute --rays " + path("short.rays") + " -o " + out), "short.rays");
+  expect_bad_input(run("trace" + mesh + " --accel brute --rays " + path("short.rays") + " -o " + out),
+                   "short.rays");
   std::string nan_rays = good_rays;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(nan_rays.data() + 16 + 4, &nan, 4);
   write("nan.rays", nan_rays);
-  expect_bad_input(run("trace" + mesh + " --accel brute --rays " + path("nan.rays") + " -o " + out), "nan.rays");
+  expect_bad_input(run("trace" + mesh + " --accel brute --rays " + path("nan.rays") + " -o " + out),
+                   "nan.rays");
   write("nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n");
-  expect_bad_input(run("trace --mesh " + path("nan.obj") + " --accel brute --rays " + path("r.rays") + " -o " + out),
-                   "nan.obj");
+  expect_bad_input(
+      run("trace --mesh " + path("nan.obj") + " --accel brute --rays " + path("r.rays") + " -o " + out),
+      "nan.obj");
   expect_bad_input(run("trace" + mesh + " --accel no-such-accel --rays " + path("r.rays") + " -o " + out),
                    "no-such-accel");
-  expect_bad_input(run("trace" + mesh + " --accel brute --param leaf=3 --rays " + path("r.rays") + " -o " + out),
-                   "leaf");
+  expect_bad_input(
+      run("trace" + mesh + " --accel brute --param leaf=3 --rays " + path("r.rays") + " -o " + out), "leaf");
   expect_bad_input(run("generate no-such-gen --triangles 10 -o " + path("x.obj")), "no-such-gen");
   expect_bad_input(run("generate soup --triangles 10 -o " + path("x.xyz")), "x.xyz");
-  expect_bad_input(run("rays" + mesh + " --kind no-such-kind --count 10 -o " + path("x.rays")), "no-such-kind");
+  expect_bad_input(run("rays" + mesh + " --kind no-such-kind --count 10 -o " + path("x.rays")),
+                   "no-such-kind");
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(path("x.obj")));
   EXPECT_FALSE(fs::exists(path("x.xyz")));

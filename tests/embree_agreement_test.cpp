@@ -1,5 +1,7 @@
 // brute force against Embree on every generator and ray kind: every disagreement must be explained
 // (tie, edge, graze, t-limit); none may be unexplained.
+#include <gtest/gtest.h>
+
 #include "accel/core/registry.h"
 #include "accel/core/trace.h"
 #include "datasets/generators.h"
@@ -7,15 +9,13 @@
 #include "harness/compare.h"
 #include "harness/target.h"
 
-#include <gtest/gtest.h>
-
 namespace ab {
 namespace {
 
 TEST(EmbreeAgreement, BruteAgreesWithEmbreeOnEveryGeneratorAndRayKind) {
   for (const auto& gen : generators()) {
-    const Target target = mesh_target(std::make_shared<const Mesh>(generate_mesh(gen.name, 4000, 2, Params{})),
-                                      gen.name);
+    const Target target =
+        mesh_target(std::make_shared<const Mesh>(generate_mesh(gen.name, 4000, 2, Params{})), gen.name);
     auto brute = make_target_accelerator(target, "brute", Params{});
     auto embree = make_target_accelerator(target, "embree", Params{});
     brute->build();
@@ -61,7 +61,8 @@ TEST(EmbreeAgreement, SliverHitsWithinRoundingOfALongEdgeAreEdgeCases) {
 }
 
 TEST(EmbreeAdapter, QualityParameterIsCheckedAndRecorded) {
-  const Target target = mesh_target(std::make_shared<const Mesh>(generate_mesh("soup", 500, 1, Params{})), "soup");
+  const Target target =
+      mesh_target(std::make_shared<const Mesh>(generate_mesh("soup", 500, 1, Params{})), "soup");
   Params p;
   p.add("quality=high");
   auto e = make_target_accelerator(target, "embree", p);

@@ -1,12 +1,12 @@
 // The cost of the embree adapter against a plain rtcIntersect1 loop on the same scene and rays
 // (issue: the adapter's overhead must stay under 5%). Run: build/accelbench_micro --benchmark_filter=Embree
-#include "accel/reference/embree.h"
+#include <benchmark/benchmark.h>
+
 #include "accel/core/registry.h"
+#include "accel/reference/embree.h"
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/target.h"
-
-#include <benchmark/benchmark.h>
 
 namespace ab {
 namespace {

@@ -16,8 +16,8 @@
 #include <sstream>
 #include <thread>
 
-#include "accel/reference/brute.h"
 #include "accel/core/registry.h"
+#include "accel/reference/brute.h"
 #include "harness/cli.h"
 
 namespace ab {
