@@ -1,16 +1,18 @@
 #include "datasets/atomic_file.h"
 
-#include "accel/core/error.h"
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
-#include <unistd.h>
+
+#include "accel/core/error.h"
 
 namespace ab {
 
-void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary) {
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write,
+                           bool binary) {
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   try {
     {

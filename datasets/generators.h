@@ -2,13 +2,13 @@
 // (and the same bytes when written).
 #pragma once
 
-#include "accel/core/mesh.h"
-#include "accel/core/params.h"
-
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "accel/core/mesh.h"
+#include "accel/core/params.h"
 
 namespace ab {
 

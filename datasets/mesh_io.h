@@ -2,9 +2,9 @@
 // contract's id rule (face order kept, polygons fan-triangulated, every face kept).
 #pragma once
 
-#include "accel/core/mesh.h"
-
 #include <string>
+
+#include "accel/core/mesh.h"
 
 namespace ab {
 

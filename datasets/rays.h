@@ -1,13 +1,13 @@
 // Ray sets: deterministic workloads made from a mesh (or anything that can be traced).
 #pragma once
 
-#include "accel/core/aabb.h"
-
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
 #include <vector>
+
+#include "accel/core/aabb.h"
 
 namespace ab {
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "accel/reference/embree_scene.h"
 #include "accel/core/registry.h"
+#include "accel/reference/embree_scene.h"
 
 namespace ab {
 

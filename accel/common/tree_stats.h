@@ -16,13 +16,13 @@
 // root's area, so it compares across structures.
 #pragma once
 
-#include "accel/common/sah.h"
-#include "accel/core/stats.h"
-
 #include <concepts>
 #include <cstdint>
 #include <utility>
 #include <vector>
+
+#include "accel/common/sah.h"
+#include "accel/core/stats.h"
 
 namespace ab {
 

@@ -1,9 +1,9 @@
 // The axis-aligned box every structure bounds its primitives and nodes with.
 #pragma once
 
-#include "accel/core/ray.h"
-
 #include <algorithm>
+
+#include "accel/core/ray.h"
 
 namespace ab {
 
@@ -39,7 +39,9 @@ struct AABB {
     return (e.x >= e.y && e.x >= e.z) ? 0 : (e.y >= e.z ? 1 : 2);
   }
   /// Intersection of two boxes (may be empty).
-  static AABB intersection(const AABB& a, const AABB& b) { return {glm::max(a.lo, b.lo), glm::min(a.hi, b.hi)}; }
+  static AABB intersection(const AABB& a, const AABB& b) {
+    return {glm::max(a.lo, b.lo), glm::min(a.hi, b.hi)};
+  }
   /// True when the boxes share at least one point (touching counts).
   bool overlaps(const AABB& b) const {
     return lo.x <= b.hi.x && b.lo.x <= hi.x && lo.y <= b.hi.y && b.lo.y <= hi.y && lo.z <= b.hi.z &&

@@ -3,16 +3,15 @@
 // per-ray loops below are non-virtual and inline the structure's traversal.
 #pragma once
 
-#include "accel/core/aabb.h"
-#include "accel/core/stats.h"
-
-#include <nlohmann/json.hpp>
-
 #include <chrono>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <utility>
+
+#include "accel/core/aabb.h"
+#include "accel/core/stats.h"
 
 namespace ab {
 
@@ -51,9 +50,11 @@ class Accelerator {
   /// Any hit within [tmin, tmax] of every ray (1 = occluded).
   virtual void occluded(std::span<const Ray> rays, std::span<uint8_t> out) const = 0;
   /// Closest hit with counters summed into `total` (the separate counting pass).
-  virtual void intersect_counted(std::span<const Ray> rays, std::span<Hit> hits, RayCounters& total) const = 0;
+  virtual void intersect_counted(std::span<const Ray> rays, std::span<Hit> hits,
+                                 RayCounters& total) const = 0;
   /// Any hit with counters summed into `total`.
-  virtual void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out, RayCounters& total) const = 0;
+  virtual void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out,
+                                RayCounters& total) const = 0;
 
   /// One ray against the structure as the bottom level of an instance: `best` holds the best hit so far
   /// (from other instances) and is updated by the acceptance rule with instance id `inst`.
@@ -99,7 +100,8 @@ class AcceleratorBase : public Accelerator {
       self().template intersect_ray<true>(rays[i], hits[i], kInvalidId, total);
     }
   }
-  void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out, RayCounters& total) const override {
+  void occluded_counted(std::span<const Ray> rays, std::span<uint8_t> out,
+                        RayCounters& total) const override {
     for (size_t i = 0; i < rays.size(); ++i) out[i] = self().template occluded_ray<true>(rays[i], total);
   }
   void intersect_one(const Ray& ray, Hit& best, uint32_t inst, RayCounters* counters) const override {

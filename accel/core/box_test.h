@@ -1,10 +1,10 @@
 // The robust ray/box slab test shared by every structure (Ize 2013, "Robust BVH ray traversal").
 #pragma once
 
+#include <cmath>
+
 #include "accel/core/aabb.h"
 #include "accel/core/ray.h"
-
-#include <cmath>
 
 namespace ab {
 
@@ -30,9 +30,13 @@ struct RayBoxData {
 inline constexpr float kBoxEps = 0x1p-16f;
 
 /// Widens a near distance towards -inf (conservative).
-inline float widen_near(float t) { return t * (t > 0.0f ? 1.0f - kBoxEps : 1.0f + kBoxEps); }
+inline float widen_near(float t) {
+  return t * (t > 0.0f ? 1.0f - kBoxEps : 1.0f + kBoxEps);
+}
 /// Widens a far distance towards +inf (conservative).
-inline float widen_far(float t) { return t * (t > 0.0f ? 1.0f + kBoxEps : 1.0f - kBoxEps); }
+inline float widen_far(float t) {
+  return t * (t > 0.0f ? 1.0f + kBoxEps : 1.0f - kBoxEps);
+}
 
 /// Clips [t0, t1] against box b. Returns false when the ray misses it within that interval.
 /// On return [t0, t1] is the (conservatively widened) overlap. The near plane per axis is chosen by

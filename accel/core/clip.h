@@ -2,10 +2,10 @@
 // builders and the exact triangle/box overlap test of the grid and the octree.
 #pragma once
 
+#include <array>
+
 #include "accel/core/aabb.h"
 #include "accel/core/triangle.h"
-
-#include <array>
 
 namespace ab {
 

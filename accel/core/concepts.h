@@ -2,16 +2,16 @@
 // fails to compile with a message naming it (docs/adding-a-structure.md walks through them).
 #pragma once
 
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
 #include "accel/core/aabb.h"
 #include "accel/core/accelerator.h"
 #include "accel/core/params.h"
 #include "accel/core/ray.h"
 #include "accel/core/stats.h"
-
-#include <concepts>
-#include <cstddef>
-#include <cstdint>
-#include <memory>
 
 namespace ab {
 
@@ -19,14 +19,14 @@ namespace ab {
 /// and fairness work"): triangle meshes (TrianglePrims) and instance sets (InstancePrims) both are one.
 /// intersect() applies the one acceptance rule (is_better_hit) and returns true when `best` changed.
 template <class P>
-concept PrimitiveSet = requires(const P& p, size_t i, const AABB& box, const Ray& ray, Hit& best, uint32_t inst,
-                                RayCounters& c) {
+concept PrimitiveSet = requires(const P& p, size_t i, const AABB& box, const Ray& ray, Hit& best,
+                                uint32_t inst, RayCounters& c) {
   { p.size() } -> std::convertible_to<size_t>;
-  { p.bounds() } -> std::same_as<AABB>;                  // bounds of everything
-  { p.bounds(i) } -> std::same_as<AABB>;                 // bounds of primitive i
-  { p.centroid(i) } -> std::same_as<vec3>;               // centre used by object-partitioning builders
-  { p.clipped_bounds(i, box) } -> std::same_as<AABB>;    // bounds of the part of i inside box
-  { p.overlaps(i, box) } -> std::same_as<bool>;          // exact overlap, touching counts
+  { p.bounds() } -> std::same_as<AABB>;                // bounds of everything
+  { p.bounds(i) } -> std::same_as<AABB>;               // bounds of primitive i
+  { p.centroid(i) } -> std::same_as<vec3>;             // centre used by object-partitioning builders
+  { p.clipped_bounds(i, box) } -> std::same_as<AABB>;  // bounds of the part of i inside box
+  { p.overlaps(i, box) } -> std::same_as<bool>;        // exact overlap, touching counts
   { p.template intersect<false>(i, ray, best, inst, c) } -> std::same_as<bool>;
   { p.template intersect<true>(i, ray, best, inst, c) } -> std::same_as<bool>;
   { p.template occluded<false>(i, ray, c) } -> std::same_as<bool>;
@@ -54,7 +54,8 @@ concept RayQueries = requires(const S& s, const Ray& ray, Hit& best, uint32_t in
 /// primitives and that Config (the build is separate), answering both ray queries.
 template <class S>
 concept Structure = std::derived_from<S, Accelerator> && PrimitiveSet<typename S::Prims> &&
-                    StructureConfig<typename S::Config> && RayQueries<S> &&
-                    std::constructible_from<S, std::shared_ptr<const typename S::Prims>, const typename S::Config&>;
+                    StructureConfig<typename S::Config> && RayQueries<S> && std::constructible_from < S,
+        std::shared_ptr<const typename S::Prims>,
+const typename S::Config& > ;
 
 }  // namespace ab

@@ -1,14 +1,13 @@
 // Instances as a primitive set: the top level of a two-level structure.
 #pragma once
 
-#include "accel/core/accelerator.h"
-#include "accel/core/clip.h"
-#include "accel/core/aabb.h"
-
 #include <glm/glm.hpp>
-
 #include <memory>
 #include <vector>
+
+#include "accel/core/aabb.h"
+#include "accel/core/accelerator.h"
+#include "accel/core/clip.h"
 
 namespace ab {
 
@@ -81,7 +80,8 @@ class InstancePrims {
   template <bool kCount>
   bool occluded(size_t i, const Ray& ray, RayCounters& c) const {
     if constexpr (kCount) ++c.prims;
-    return instances_[i].base->occluded_one(transform_ray(ray, instances_[i].to_object), kCount ? &c : nullptr);
+    return instances_[i].base->occluded_one(transform_ray(ray, instances_[i].to_object),
+                                            kCount ? &c : nullptr);
   }
 
  private:

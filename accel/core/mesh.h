@@ -1,11 +1,10 @@
 // An indexed triangle mesh: the input every structure is built over.
 #pragma once
 
-#include "accel/core/triangle.h"
-
 #include <glm/glm.hpp>
-
 #include <vector>
+
+#include "accel/core/triangle.h"
 
 namespace ab {
 

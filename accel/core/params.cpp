@@ -8,7 +8,8 @@ namespace ab {
 
 void Params::add(const std::string& kv) {
   const auto eq = kv.find('=');
-  if (eq == std::string::npos || eq == 0) throw ParamError("parameter '" + kv + "' is not of the form key=value");
+  if (eq == std::string::npos || eq == 0)
+    throw ParamError("parameter '" + kv + "' is not of the form key=value");
   const std::string key = kv.substr(0, eq);
   if (values_.count(key)) throw ParamError("parameter '" + key + "' is given twice");
   values_[key] = kv.substr(eq + 1);
@@ -30,8 +31,8 @@ long long Params::get_int(const std::string& key, long long def, long long lo, l
       throw ParamError("parameter '" + key + "': '" + *s + "' is not an integer");
   }
   if (value < lo || value > hi)
-    throw ParamError("parameter '" + key + "': " + std::to_string(value) + " is outside [" + std::to_string(lo) +
-                     ", " + std::to_string(hi) + "]");
+    throw ParamError("parameter '" + key + "': " + std::to_string(value) + " is outside [" +
+                     std::to_string(lo) + ", " + std::to_string(hi) + "]");
   effective_[key] = value;
   return value;
 }
@@ -45,8 +46,8 @@ double Params::get_float(const std::string& key, double def, double lo, double h
       throw ParamError("parameter '" + key + "': '" + *s + "' is not a finite number");
   }
   if (value < lo || value > hi)
-    throw ParamError("parameter '" + key + "': " + std::to_string(value) + " is outside [" + std::to_string(lo) +
-                     ", " + std::to_string(hi) + "]");
+    throw ParamError("parameter '" + key + "': " + std::to_string(value) + " is outside [" +
+                     std::to_string(lo) + ", " + std::to_string(hi) + "]");
   effective_[key] = value;
   return value;
 }
@@ -67,9 +68,12 @@ std::string Params::get_choice(const std::string& key, const std::string& def,
 bool Params::get_bool(const std::string& key, bool def) {
   bool value = def;
   if (const std::string* s = find(key)) {
-    if (*s == "true" || *s == "1" || *s == "yes" || *s == "on") value = true;
-    else if (*s == "false" || *s == "0" || *s == "no" || *s == "off") value = false;
-    else throw ParamError("parameter '" + key + "': '" + *s + "' is not a boolean");
+    if (*s == "true" || *s == "1" || *s == "yes" || *s == "on")
+      value = true;
+    else if (*s == "false" || *s == "0" || *s == "no" || *s == "off")
+      value = false;
+    else
+      throw ParamError("parameter '" + key + "': '" + *s + "' is not a boolean");
   }
   effective_[key] = value;
   return value;

@@ -1,15 +1,14 @@
 // Structure parameters given as k=v strings (CLI --param, suite files), checked strictly.
 #pragma once
 
-#include "accel/core/error.h"
-
-#include <nlohmann/json.hpp>
-
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include "accel/core/error.h"
 
 namespace ab {
 
@@ -35,7 +34,8 @@ class Params {
   /// Reads a finite number in [lo, hi].
   double get_float(const std::string& key, double def, double lo, double hi);
   /// Reads one of the allowed words.
-  std::string get_choice(const std::string& key, const std::string& def, const std::set<std::string>& allowed);
+  std::string get_choice(const std::string& key, const std::string& def,
+                         const std::set<std::string>& allowed);
   /// Reads a boolean (true/false/1/0/yes/no/on/off).
   bool get_bool(const std::string& key, bool def);
 
@@ -43,8 +43,8 @@ class Params {
   /// written once, in its Config's initializers) and the value read replaces it. Integers and floats are
   /// checked against [lo, hi].
   template <class T>
-    requires std::is_arithmetic_v<T> && (!std::is_same_v<T, bool>)
-  void read(const std::string& key, T& field, double lo, double hi) {
+  requires std::is_arithmetic_v<T> &&
+      (!std::is_same_v<T, bool>)void read(const std::string& key, T& field, double lo, double hi) {
     if constexpr (std::is_integral_v<T>) {
       field = T(get_int(key, (long long)field, (long long)lo, (long long)hi));
     } else {

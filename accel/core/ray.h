@@ -1,9 +1,8 @@
 // Ray and Hit, the records of the .rays and .hits files, and the one acceptance rule every structure uses.
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 
 namespace ab {

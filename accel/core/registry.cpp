@@ -19,7 +19,9 @@ Registrar::Registrar(AcceleratorInfo info) {
   });
 }
 
-const std::vector<AcceleratorInfo>& accelerators() { return table(); }
+const std::vector<AcceleratorInfo>& accelerators() {
+  return table();
+}
 
 const AcceleratorInfo& find_accelerator(const std::string& name) {
   for (const auto& info : table())
@@ -29,8 +31,8 @@ const AcceleratorInfo& find_accelerator(const std::string& name) {
   throw UnknownAccelerator("unknown accelerator '" + name + "' (known: " + known + ")");
 }
 
-std::unique_ptr<Accelerator> make_accelerator(const std::string& name, std::shared_ptr<const TrianglePrims> prims,
-                                              Params params) {
+std::unique_ptr<Accelerator> make_accelerator(const std::string& name,
+                                              std::shared_ptr<const TrianglePrims> prims, Params params) {
   const AcceleratorInfo& info = find_accelerator(name);
   auto accel = info.make_for_mesh(std::move(prims), params);
   params.finish(name);
@@ -50,7 +52,8 @@ nlohmann::json default_params(const std::string& name) {
 }
 
 std::unique_ptr<Accelerator> make_instance_accelerator(const std::string& name,
-                                                       std::shared_ptr<const InstancePrims> prims, Params params) {
+                                                       std::shared_ptr<const InstancePrims> prims,
+                                                       Params params) {
   const AcceleratorInfo& info = find_accelerator(name);
   if (!info.make_for_instances)
     throw UnknownAccelerator("accelerator '" + name + "' cannot serve as the top level of a scene");

@@ -1,18 +1,18 @@
 // Accelerator names -> factories. Unknown names and unknown parameters are errors.
 #pragma once
 
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
 #include "accel/core/accelerator.h"
 #include "accel/core/concepts.h"
 #include "accel/core/error.h"
 #include "accel/core/instances.h"
 #include "accel/core/params.h"
 #include "accel/core/primitives.h"
-
-#include <functional>
-#include <memory>
-#include <stdexcept>
-#include <string>
-#include <vector>
 
 namespace ab {
 
@@ -22,7 +22,8 @@ struct UnknownAccelerator : InputError {
 };
 
 /// Factory over a triangle set. It reads its Config from params (Params::get_*).
-using MeshFactory = std::function<std::unique_ptr<Accelerator>(std::shared_ptr<const TrianglePrims>, Params&)>;
+using MeshFactory =
+    std::function<std::unique_ptr<Accelerator>(std::shared_ptr<const TrianglePrims>, Params&)>;
 /// Factory over an instance set (the top level of a scene).
 using InstanceFactory =
     std::function<std::unique_ptr<Accelerator>(std::shared_ptr<const InstancePrims>, Params&)>;
@@ -31,10 +32,10 @@ using InstanceFactory =
 struct AcceleratorInfo {
   std::string name;
   std::string description;
-  int order = 100;                ///< position in listings (smaller first)
+  int order = 100;  ///< position in listings (smaller first)
   MeshFactory make_for_mesh;
   InstanceFactory make_for_instances;  ///< empty when the structure cannot be a top level
-  bool is_reference = false;      ///< brute and embree: not a structure of the project's own
+  bool is_reference = false;           ///< brute and embree: not a structure of the project's own
 };
 
 /// Registers at static-initialization time: `static const Registrar reg{{"name", "...", 10, f, g}};`
@@ -54,24 +55,26 @@ const std::vector<AcceleratorInfo>& accelerators();
 const AcceleratorInfo& find_accelerator(const std::string& name);
 /// Creates (does not build) an accelerator over triangles; throws UnknownAccelerator or ParamError
 /// (unknown or bad parameters).
-std::unique_ptr<Accelerator> make_accelerator(const std::string& name, std::shared_ptr<const TrianglePrims> prims,
-                                              Params params);
+std::unique_ptr<Accelerator> make_accelerator(const std::string& name,
+                                              std::shared_ptr<const TrianglePrims> prims, Params params);
 /// Creates (does not build) a top-level accelerator over instances.
 std::unique_ptr<Accelerator> make_instance_accelerator(const std::string& name,
-                                                       std::shared_ptr<const InstancePrims> prims, Params params);
+                                                       std::shared_ptr<const InstancePrims> prims,
+                                                       Params params);
 
 /// The factory of structure S over primitive set P: reads S's Config from the parameters once and passes
 /// it typed to the constructor (the shape of pbrt-v4's Create()).
 template <class S>
-std::unique_ptr<Accelerator> create_structure(std::shared_ptr<const typename S::Prims> prims, Params& params) {
+std::unique_ptr<Accelerator> create_structure(std::shared_ptr<const typename S::Prims> prims,
+                                              Params& params) {
   return std::make_unique<S>(std::move(prims), S::Config::read(params));
 }
 
 /// Describes structure template S for the registry, over both primitive sets; the concepts name what is
 /// missing when S<P> is not a Structure. The name given here is the only place it is written.
 template <template <class> class S>
-  requires Structure<S<TrianglePrims>> && Structure<S<InstancePrims>>
-AcceleratorInfo structure_info(std::string name, std::string description, int order) {
+requires Structure<S<TrianglePrims>> && Structure<S<InstancePrims>> AcceleratorInfo
+structure_info(std::string name, std::string description, int order) {
   AcceleratorInfo info;
   info.name = std::move(name);
   info.description = std::move(description);
@@ -89,7 +92,8 @@ AcceleratorInfo legacy_structure_info(std::string name, std::string description,
   info.name = std::move(name);
   info.description = std::move(description);
   info.order = order;
-  info.make_for_mesh = [](std::shared_ptr<const TrianglePrims> p, Params& params) -> std::unique_ptr<Accelerator> {
+  info.make_for_mesh = [](std::shared_ptr<const TrianglePrims> p,
+                          Params& params) -> std::unique_ptr<Accelerator> {
     return std::make_unique<S<TrianglePrims>>(std::move(p), params);
   };
   info.make_for_instances = [](std::shared_ptr<const InstancePrims> p,

@@ -1,10 +1,9 @@
 // Build statistics and per-ray traversal counters, shared by every structure.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace ab {
@@ -28,21 +27,23 @@ struct RayCounters {
 
 /// What a build produced. Fields that do not apply to a structure stay zero.
 struct BuildStats {
-  double build_seconds = 0.0;     ///< wall time of build() alone
-  uint64_t primitives = 0;        ///< triangles (or instances) it was built over
-  uint64_t nodes = 0;             ///< all nodes (or cells)
-  uint64_t leaves = 0;            ///< leaves (or cells)
-  uint64_t empty_leaves = 0;      ///< leaves or cells holding no primitive
-  uint32_t max_depth = 0;         ///< deepest leaf
-  double mean_leaf_depth = 0.0;   ///< mean depth over leaves
-  uint64_t references = 0;        ///< primitive references stored in leaves or cells
-  uint64_t bytes = 0;             ///< memory of the structure itself (not the input mesh)
-  double sah_cost = 0.0;          ///< SAH cost, costs 1 and 1, normalized by the root's area (0: not computed)
+  double build_seconds = 0.0;    ///< wall time of build() alone
+  uint64_t primitives = 0;       ///< triangles (or instances) it was built over
+  uint64_t nodes = 0;            ///< all nodes (or cells)
+  uint64_t leaves = 0;           ///< leaves (or cells)
+  uint64_t empty_leaves = 0;     ///< leaves or cells holding no primitive
+  uint32_t max_depth = 0;        ///< deepest leaf
+  double mean_leaf_depth = 0.0;  ///< mean depth over leaves
+  uint64_t references = 0;       ///< primitive references stored in leaves or cells
+  uint64_t bytes = 0;            ///< memory of the structure itself (not the input mesh)
+  double sah_cost = 0.0;         ///< SAH cost, costs 1 and 1, normalized by the root's area (0: not computed)
   std::map<uint32_t, uint64_t> leaf_size_histogram;  ///< primitives per leaf -> number of leaves
-  nlohmann::json extra = nlohmann::json::object();  ///< structure-specific figures (grid resolution, ...)
+  nlohmann::json extra = nlohmann::json::object();   ///< structure-specific figures (grid resolution, ...)
 
   /// Primitive references per primitive (1 for structures that never duplicate).
-  double references_per_primitive() const { return primitives ? double(references) / double(primitives) : 0.0; }
+  double references_per_primitive() const {
+    return primitives ? double(references) / double(primitives) : 0.0;
+  }
   /// Bytes per primitive.
   double bytes_per_primitive() const { return primitives ? double(bytes) / double(primitives) : 0.0; }
   /// Adds one leaf of `size` primitives at `depth` to the counts (nodes are counted by the caller).

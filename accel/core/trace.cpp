@@ -21,13 +21,16 @@ void run_chunks(size_t n, int threads, F&& body) {
 }  // namespace
 
 void trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits, int threads) {
-  run_chunks(rays.size(), threads,
-             [&](size_t begin, size_t count) { accel.intersect(rays.subspan(begin, count), hits.subspan(begin, count)); });
+  run_chunks(rays.size(), threads, [&](size_t begin, size_t count) {
+    accel.intersect(rays.subspan(begin, count), hits.subspan(begin, count));
+  });
 }
 
-void trace_occluded(const Accelerator& accel, std::span<const Ray> rays, std::span<uint8_t> out, int threads) {
-  run_chunks(rays.size(), threads,
-             [&](size_t begin, size_t count) { accel.occluded(rays.subspan(begin, count), out.subspan(begin, count)); });
+void trace_occluded(const Accelerator& accel, std::span<const Ray> rays, std::span<uint8_t> out,
+                    int threads) {
+  run_chunks(rays.size(), threads, [&](size_t begin, size_t count) {
+    accel.occluded(rays.subspan(begin, count), out.subspan(begin, count));
+  });
 }
 
 RayCounters trace_closest_counted(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,

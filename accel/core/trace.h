@@ -1,9 +1,9 @@
 // Tracing a batch of rays on TBB: the same hits for every thread count (each ray is independent).
 #pragma once
 
-#include "accel/core/accelerator.h"
-
 #include <span>
+
+#include "accel/core/accelerator.h"
 
 namespace ab {
 

@@ -32,9 +32,15 @@ struct TriangleHit {
 };
 
 /// Scalar lane helpers: absolute value, "no lane true", "both true".
-inline float lane_abs(float x) { return std::fabs(x); }
-inline bool lane_none(bool m) { return !m; }
-inline bool lane_and(bool a, bool b) { return a && b; }
+inline float lane_abs(float x) {
+  return std::fabs(x);
+}
+inline bool lane_none(bool m) {
+  return !m;
+}
+inline bool lane_and(bool a, bool b) {
+  return a && b;
+}
 
 /// Three coordinates of lane type T (float here, four lanes in triangle4.h). The kernel below is written
 /// once over T, with glm's dot and cross expanded in glm's order, so the scalar and the four-lane kernels
@@ -105,7 +111,9 @@ template <class T>
 }
 
 /// A glm vector as kernel coordinates.
-inline Vec3T<float> to_lanes(const vec3& a) { return {a.x, a.y, a.z}; }
+inline Vec3T<float> to_lanes(const vec3& a) {
+  return {a.x, a.y, a.z};
+}
 
 /// True when the kernel treats the ray as lying in the triangle's plane (it never reports a hit then).
 inline bool kernel_calls_parallel(const Ray& ray, const Triangle& tri) {
@@ -134,7 +142,8 @@ inline bool accept_hit(const TriangleHit& th, uint32_t prim, uint32_t inst, Hit&
 
 /// Tests triangle `prim` of instance `inst` and, when it is hit and better than `best` by the
 /// one acceptance rule (is_better_hit), records it. Returns true when `best` changed.
-inline bool intersect_and_update(const Ray& ray, const Triangle& tri, uint32_t prim, uint32_t inst, Hit& best) {
+inline bool intersect_and_update(const Ray& ray, const Triangle& tri, uint32_t prim, uint32_t inst,
+                                 Hit& best) {
   TriangleHit th;
   return intersect_triangle(ray, tri, th) && accept_hit(th, prim, inst, best);
 }

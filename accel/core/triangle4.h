@@ -3,12 +3,12 @@
 // same order, so each lane's t, u, v and verdict are the bits intersect_triangle gives for that triangle.
 #pragma once
 
-#include "accel/core/triangle.h"
-
 #include <immintrin.h>
 
 #include <cstdint>
 #include <span>
+
+#include "accel/core/triangle.h"
 
 namespace ab {
 
@@ -24,17 +24,39 @@ struct Lanes4 {
 struct Mask4 {
   __m128 m;
 };
-inline Lanes4 operator+(Lanes4 a, Lanes4 b) { return Lanes4(_mm_add_ps(a.v, b.v)); }
-inline Lanes4 operator-(Lanes4 a, Lanes4 b) { return Lanes4(_mm_sub_ps(a.v, b.v)); }
-inline Lanes4 operator*(Lanes4 a, Lanes4 b) { return Lanes4(_mm_mul_ps(a.v, b.v)); }
-inline Lanes4 operator/(Lanes4 a, Lanes4 b) { return Lanes4(_mm_div_ps(a.v, b.v)); }
-inline Lanes4 operator-(Lanes4 a) { return Lanes4(_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))); }
-inline Mask4 operator>(Lanes4 a, Lanes4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
-inline Mask4 operator>=(Lanes4 a, Lanes4 b) { return {_mm_cmpge_ps(a.v, b.v)}; }
-inline Mask4 operator<=(Lanes4 a, Lanes4 b) { return {_mm_cmple_ps(a.v, b.v)}; }
-inline Lanes4 lane_abs(Lanes4 a) { return Lanes4(_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)); }
-inline bool lane_none(Mask4 m) { return _mm_movemask_ps(m.m) == 0; }
-inline Mask4 lane_and(Mask4 a, Mask4 b) { return {_mm_and_ps(a.m, b.m)}; }
+inline Lanes4 operator+(Lanes4 a, Lanes4 b) {
+  return Lanes4(_mm_add_ps(a.v, b.v));
+}
+inline Lanes4 operator-(Lanes4 a, Lanes4 b) {
+  return Lanes4(_mm_sub_ps(a.v, b.v));
+}
+inline Lanes4 operator*(Lanes4 a, Lanes4 b) {
+  return Lanes4(_mm_mul_ps(a.v, b.v));
+}
+inline Lanes4 operator/(Lanes4 a, Lanes4 b) {
+  return Lanes4(_mm_div_ps(a.v, b.v));
+}
+inline Lanes4 operator-(Lanes4 a) {
+  return Lanes4(_mm_xor_ps(a.v, _mm_set1_ps(-0.0f)));
+}
+inline Mask4 operator>(Lanes4 a, Lanes4 b) {
+  return {_mm_cmpgt_ps(a.v, b.v)};
+}
+inline Mask4 operator>=(Lanes4 a, Lanes4 b) {
+  return {_mm_cmpge_ps(a.v, b.v)};
+}
+inline Mask4 operator<=(Lanes4 a, Lanes4 b) {
+  return {_mm_cmple_ps(a.v, b.v)};
+}
+inline Lanes4 lane_abs(Lanes4 a) {
+  return Lanes4(_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v));
+}
+inline bool lane_none(Mask4 m) {
+  return _mm_movemask_ps(m.m) == 0;
+}
+inline Mask4 lane_and(Mask4 a, Mask4 b) {
+  return {_mm_and_ps(a.m, b.m)};
+}
 
 /// Four triangles in structure-of-arrays form: v[vertex][axis][lane]. Unused lanes hold a zero-area
 /// triangle (all vertices at the origin), which the kernel never reports.
@@ -70,11 +92,11 @@ struct Ray4 {
 };
 
 /// The kernel on four triangles: returns the mask of lanes hit (bit k for lane k) and their t, u, v.
-[[gnu::always_inline]] inline unsigned intersect_triangle4(const Ray4& ray, const Triangle4& tris, float* t, float* u,
-                                                           float* v) {
+[[gnu::always_inline]] inline unsigned intersect_triangle4(const Ray4& ray, const Triangle4& tris, float* t,
+                                                           float* u, float* v) {
   Lanes4 lt, lu, lv;
-  const Mask4 hit =
-      triangle_kernel<Lanes4>(ray.org, ray.dir, ray.tmin, ray.tmax, tris.corner(0), tris.corner(1), tris.corner(2), lt, lu, lv);
+  const Mask4 hit = triangle_kernel<Lanes4>(ray.org, ray.dir, ray.tmin, ray.tmax, tris.corner(0),
+                                            tris.corner(1), tris.corner(2), lt, lu, lv);
   const unsigned mask = unsigned(_mm_movemask_ps(hit.m));
   if (mask) {
     _mm_storeu_ps(t, lt.v);

@@ -1,10 +1,10 @@
 // Brute force: tests every primitive. The ground truth for every structure of the project.
 #pragma once
 
+#include <memory>
+
 #include "accel/core/accelerator.h"
 #include "accel/core/params.h"
-
-#include <memory>
 
 namespace ab {
 
