@@ -7,9 +7,11 @@
 //   vec3 centroid(size_t i) const;                        // centre used by object-partitioning builders
 //   AABB clipped_bounds(size_t i, const AABB& box) const; // bounds of the part of i inside box (empty: none)
 //   bool overlaps(size_t i, const AABB& box) const;       // exact overlap (touching counts)
-//   template <bool kCount> bool intersect(size_t i, const Ray&, Hit& best, uint32_t inst, RayCounters&)
-//   const; template <bool kCount> bool occluded(size_t i, const Ray&, RayCounters&) const; AABB bounds()
-//   const;                                  // bounds of everything
+//   template <bool kCount>
+//   bool intersect(size_t i, const Ray&, Hit& best, uint32_t inst, RayCounters&) const;
+//   template <bool kCount>
+//   bool occluded(size_t i, const Ray&, RayCounters&) const;
+//   AABB bounds() const;                                  // bounds of everything
 // intersect() applies the one acceptance rule (is_better_hit) and returns true when best changed.
 #pragma once
 
