@@ -38,8 +38,8 @@ namespace ab {
 template <class P, class C>
 class Bvh final : public AcceleratorBase<Bvh<P, C>> {
  public:
-  using Prims = P;
-  using Config = C;
+  using Prims = P;   ///< the primitive set
+  using Config = C;  ///< the Config, which also chooses the builder (build_bvh's overloads)
 
   /// Over prims with the given Config; the build is separate (build()).
   Bvh(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {
@@ -48,6 +48,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
       if (config_.width == 8 && kCopiesTriangles) config_.costs.block = 4;
   }
 
+  /// Bounds of every primitive.
   AABB bounds() const override { return prims_->bounds(); }
   /// The flattened binary nodes (empty for width 8, whose build frees them; for tests).
   const BvhNodeArray& nodes() const { return nodes_; }
@@ -73,7 +74,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
       return;
     }
     if (nodes_.empty()) return;
-    walk_bvh2<kCount>(
+    walk_bvh2<kCount, true>(
         nodes_.data(), ray, limit,
         [&](uint32_t first, uint32_t count) {
           for (uint32_t k = first, e = first + count; k < e; ++k)
@@ -96,7 +97,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
       return walk_bvh8<kCount, false>(wide_.data(), ray, limit, leaf, leaf_data(), sizeof(Triangle4), c);
     }
     if (nodes_.empty()) return false;
-    return walk_bvh2<kCount>(
+    return walk_bvh2<kCount, false>(
         nodes_.data(), ray, limit,
         [&](uint32_t first, uint32_t count) {
           for (uint32_t k = first, e = first + count; k < e; ++k)

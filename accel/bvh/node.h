@@ -17,10 +17,10 @@ inline constexpr int kBvhMaxDepth = 120;
 /// [offset, offset + count) of the leaf-ordered reference array. The layout (lo, offset, hi, count) lets
 /// a node load as one 32-byte vector. Node 0 is the root, node 1 is padding, pairs start at 2.
 struct alignas(32) BvhNode {
-  float lo[3];
-  uint32_t offset;
-  float hi[3];
-  uint32_t count;
+  float lo[3];      ///< box minimum
+  uint32_t offset;  ///< interior: the children's pair; leaf: the first primitive of leaf order
+  float hi[3];      ///< box maximum
+  uint32_t count;   ///< primitives of a leaf, 0 for an interior node
 
   /// True for a leaf.
   bool is_leaf() const { return count > 0; }

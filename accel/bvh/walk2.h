@@ -64,10 +64,11 @@ struct BvhStackEntry {
 /// Front-to-back walk of a binary BVH (nodes as build_bvh lays them out; not empty). `limit()` is the
 /// current upper bound of the box tests (min(tmax, best.t) for closest hit, tmax for any hit);
 /// `leaf(first, count)` tests a leaf's primitives [first, first + count) of leaf order and returns true
-/// to end the walk. The nearer entered child is visited first, the farther one is stacked (and its
-/// children's pair prefetched); a stacked node is skipped only when its entry lies strictly beyond
-/// limit(). Returns true when a leaf ended the walk.
-template <bool kCount, class Limit, class Leaf>
+/// to end the walk. The nearer entered child is visited first, the farther one is stacked (and, with
+/// kPrefetchFar, its children's pair prefetched: closest hit visits most stacked nodes, any hit often ends
+/// before); a stacked node is skipped only when its entry lies strictly beyond limit(). Returns true when
+/// a leaf ended the walk.
+template <bool kCount, bool kPrefetchFar, class Limit, class Leaf>
 [[gnu::always_inline]] inline bool walk_bvh2(const BvhNode* nodes, const Ray& ray, Limit limit, Leaf leaf,
                                              RayCounters& c) {
   const BvhPairTest test(ray);
@@ -86,7 +87,8 @@ template <bool kCount, class Limit, class Leaf>
         idx = left_first ? l : r;
         const uint32_t far = left_first ? r : l;
         stack.push({far, left_first ? tr : tl});
-        if (!nodes[far].is_leaf()) __builtin_prefetch(nodes + nodes[far].offset);
+        if constexpr (kPrefetchFar)
+          if (!nodes[far].is_leaf()) __builtin_prefetch(nodes + nodes[far].offset);
         continue;
       }
       if (tl != kInf || tr != kInf) {

@@ -114,20 +114,18 @@ struct Bvh8StackEntry {
 /// The 8-wide walk's stack: at most seven children wait per level.
 using Bvh8Stack = TraversalStack<Bvh8StackEntry, 7 * kBvhMaxDepth + 8>;
 
-/// Stacks the children of node n entered by the lanes of `mask` (at least two) and returns the one to visit
-/// next: sorted by entry distance, farthest stacked first (kSorted), or in lane order with the last lane
-/// next. Stacked nodes and leaf data (`leaf_data` + child * `leaf_stride` bytes, when not null) are
+/// Stacks the children of node n entered by lane k and the lanes of `rest` (not empty) and returns the one
+/// to visit next: sorted by entry distance, farthest stacked first (kSorted), or in lane order with the last
+/// lane next. Stacked nodes and leaf data (`leaf_data` + child * `leaf_stride` bytes, when not null) are
 /// prefetched.
 template <bool kSorted>
 [[gnu::always_inline]] inline Bvh8StackEntry stack_entered_children(const Bvh8Node* nodes, const Bvh8Node& n,
-                                                                    unsigned mask, const float* t,
+                                                                    int k, unsigned rest, const float* t,
                                                                     Bvh8Stack& stack, const char* leaf_data,
                                                                     size_t leaf_stride) {
   Bvh8StackEntry items[8];
   int m = 0;
-  while (mask != 0) {
-    const int k = std::countr_zero(mask);
-    mask &= mask - 1;
+  for (;;) {
     const Bvh8StackEntry it{n.child[k], n.count[k], t[k]};
     if constexpr (kSorted) {  // insertion sort, farthest first
       int j = m;
@@ -137,6 +135,9 @@ template <bool kSorted>
       items[m] = it;
     }
     ++m;
+    if (rest == 0) break;
+    k = std::countr_zero(rest);
+    rest &= rest - 1;
   }
   for (int j = 0; j + 1 < m; ++j) {
     if (items[j].count == 0) {
@@ -168,11 +169,12 @@ template <bool kCount, bool kSorted, class Limit, class Leaf>
       alignas(32) float t[8];
       const unsigned mask = test.entries(n, limit(), t);
       if (mask != 0) {
-        if ((mask & (mask - 1)) == 0) {  // one child entered: no stack traffic
-          const int k = std::countr_zero(mask);
+        const int k = std::countr_zero(mask);
+        const unsigned rest = mask & (mask - 1);
+        if (rest == 0) {  // one child entered: no stack traffic
           cur = {n.child[k], n.count[k], t[k]};
         } else {
-          cur = stack_entered_children<kSorted>(nodes, n, mask, t, stack, leaf_data, leaf_stride);
+          cur = stack_entered_children<kSorted>(nodes, n, k, rest, t, stack, leaf_data, leaf_stride);
         }
         continue;
       }

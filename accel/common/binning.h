@@ -11,7 +11,7 @@ namespace ab {
 
 /// Maps a centroid coordinate to one of `bins` bins over [lo, lo + extent] (Wald 2007, eq. for k1).
 struct BinMapping {
-  vec3 lo{0.0f};
+  vec3 lo{0.0f};     ///< minimum of the centroid bounds
   vec3 scale{0.0f};  ///< bins / extent per axis (0 for a flat axis: everything in bin 0)
   int bins = 1;      ///< bins per axis
 
