@@ -10,7 +10,7 @@ namespace ab {
 /// Allocator aligning every allocation to 64 bytes (a cache line).
 template <class T>
 struct CacheLineAllocator {
-  using value_type = T;
+  using value_type = T;  ///< the element type
   /// A stateless allocator.
   CacheLineAllocator() = default;
   /// Rebinding from another element type.

@@ -42,8 +42,9 @@ inline bool holds_child(const Bvh8Node& node, int k) {
 struct Bvh8TreeVisitor {
   /// A wide node (count 0: index child) or a leaf (primitives [child, child + count)), with its box.
   struct Node {
-    uint32_t child, count;
-    AABB box;
+    uint32_t child;  ///< wide node index (count 0) or first primitive (or block) of a leaf
+    uint32_t count;  ///< primitives of a leaf, 0 for a wide node
+    AABB box;        ///< the lane's box (the union of the root's lanes for the root)
   };
   const Bvh8NodeArray& nodes;  ///< the tree
 
