@@ -1,14 +1,16 @@
 // Tests of the BVH builders themselves (build_bvh): the presorted full sweep against a naive sweep that
 // re-sorts at every node, thread independence with the parallel paths forced on, forced splits.
-#include "accel/bvh/build.h"
-#include "tests/structure_test_helpers.h"
-
-#include <tbb/task_arena.h>
-
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstring>
+
+#include "accel/bvh/build.h"
+#include "accel/bvh/sah_split.h"
+#include "accel/bvh/tree_visitors.h"
+#include "accel/common/tree_stats.h"
+#include "tests/structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -19,6 +21,13 @@ struct Inputs {
   std::vector<AABB> bounds;
   std::vector<vec3> centroids;
 };
+
+/// The figures of a built tree, from the one statistics walk.
+BuildStats stats_of(const BvhBuildResult& r) {
+  BuildStats stats;
+  if (!r.nodes.empty()) walk_tree_stats(BvhTreeVisitor{r.nodes}, stats);
+  return stats;
+}
 
 Inputs inputs_of(const Mesh& mesh) {
   Inputs in;
@@ -33,7 +42,7 @@ Inputs inputs_of(const Mesh& mesh) {
 /// split, recurse. Checks the built tree node by node: the same box, the same leaves with the same ids.
 class NaiveSweepCheck {
  public:
-  NaiveSweepCheck(const Inputs& in, const BvhConfig& config, const BvhBuildResult& built)
+  NaiveSweepCheck(const Inputs& in, const BvhSweepConfig& config, const BvhBuildResult& built)
       : in_(in), config_(config), built_(built) {}
 
   void check(std::vector<uint32_t> ids, uint32_t node, int depth) {
@@ -76,7 +85,8 @@ class NaiveSweepCheck {
     });
     return ids;
   }
-  void sweep_axis(const std::vector<uint32_t>& ids, int a, float area, SahSplit& best, std::vector<uint32_t>& order) {
+  void sweep_axis(const std::vector<uint32_t>& ids, int a, float area, SahSplit& best,
+                  std::vector<uint32_t>& order) {
     const std::vector<uint32_t> s = sorted(ids, a);
     if (!(in_.centroids[s.back()][a] > in_.centroids[s.front()][a])) return;
     const size_t n = s.size();
@@ -90,7 +100,7 @@ class NaiveSweepCheck {
   }
 
   const Inputs& in_;
-  const BvhConfig& config_;
+  const BvhSweepConfig& config_;
   const BvhBuildResult& built_;
 };
 
@@ -99,42 +109,48 @@ TEST(BvhBuild, PresortedSweepEqualsResortingAtEveryNode) {
   // Equal centroids on some axes (ties resolved by id) and a cluster of duplicates (forced splits).
   for (size_t i = 0; i < 40; ++i) mesh.triangles.push_back(mesh.triangles[i % 4]);
   const Inputs in = inputs_of(mesh);
-  BvhConfig config;
+  BvhSweepConfig config;
   config.max_leaf_size = 4;
   config.parallel_threshold = 64;
-  const BvhBuildResult built = build_bvh(BvhMethod::kSweepSah, config, in.bounds, in.centroids);
+  const BvhBuildResult built = build_bvh(config, in.bounds, in.centroids);
   std::vector<uint32_t> all(mesh.size());
   for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
   NaiveSweepCheck(in, config, built).check(all, 0, 0);
 }
 
 /// Builds with `threads` threads and the parallel paths forced on for small subtrees.
-BvhBuildResult build_with(BvhMethod method, const Inputs& in, int threads) {
-  BvhConfig config;
+template <class Config>
+BvhBuildResult build_with(const Inputs& in, int threads) {
+  Config config;
   config.parallel_threshold = 32;
   tbb::task_arena arena(threads);
   BvhBuildResult r;
-  arena.execute([&] { r = build_bvh(method, config, in.bounds, in.centroids); });
+  arena.execute([&] { r = build_bvh(config, in.bounds, in.centroids); });
   return r;
+}
+
+/// The same tree with one and with two threads, for the builder of Config.
+template <class Config>
+void expect_same_tree_for_any_thread_count(const Inputs& in, const char* name) {
+  const BvhBuildResult one = build_with<Config>(in, 1), two = build_with<Config>(in, 2);
+  ASSERT_EQ(one.nodes.size(), two.nodes.size()) << name;
+  EXPECT_EQ(std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(BvhNode)), 0) << name;
+  EXPECT_EQ(one.order, two.order) << name;
+  EXPECT_EQ(stats_of(one).sah_cost, stats_of(two).sah_cost);
 }
 
 TEST(BvhBuild, SameTreeForAnyThreadCountWithParallelPathsForced) {
   const Inputs in = inputs_of(random_soup(70000, 21, 0.01f));  // above the parallel binning threshold
-  for (BvhMethod method : {BvhMethod::kBinnedSah, BvhMethod::kSweepSah, BvhMethod::kMedian}) {
-    const BvhBuildResult one = build_with(method, in, 1), two = build_with(method, in, 2);
-    ASSERT_EQ(one.nodes.size(), two.nodes.size()) << bvh_method_name(method);
-    EXPECT_EQ(std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(BvhNode)), 0)
-        << bvh_method_name(method);
-    EXPECT_EQ(one.order, two.order) << bvh_method_name(method);
-    EXPECT_EQ(one.stats.sah_cost, two.stats.sah_cost);
-  }
+  expect_same_tree_for_any_thread_count<BvhSahConfig>(in, "bvh-sah");
+  expect_same_tree_for_any_thread_count<BvhSweepConfig>(in, "bvh-sweep");
+  expect_same_tree_for_any_thread_count<BvhMedianConfig>(in, "bvh-median");
 }
 
 TEST(BvhBuild, BinnedChildBoxesAreTightAndLeavesAPermutation) {
   const Mesh mesh = random_soup(5000, 8, 0.05f);
   const Inputs in = inputs_of(mesh);
-  BvhConfig config;
-  const BvhBuildResult r = build_bvh(BvhMethod::kBinnedSah, config, in.bounds, in.centroids);
+  BvhSahConfig config;
+  const BvhBuildResult r = build_bvh(config, in.bounds, in.centroids);
   std::vector<int> seen(mesh.size(), 0);
   // Each node's box is exactly the union of its children's (or its primitives') boxes.
   for (size_t i = 0; i < r.nodes.size(); ++i) {
@@ -143,7 +159,8 @@ TEST(BvhBuild, BinnedChildBoxesAreTightAndLeavesAPermutation) {
     AABB u;
     if (n.is_leaf()) {
       EXPECT_LE(n.count, uint32_t(config.max_leaf_size));
-      for (uint32_t k = n.offset; k < n.offset + n.count; ++k) u.extend(in.bounds[r.order[k]]), ++seen[r.order[k]];
+      for (uint32_t k = n.offset; k < n.offset + n.count; ++k)
+        u.extend(in.bounds[r.order[k]]), ++seen[r.order[k]];
     } else {
       u.extend(r.nodes[n.offset].box());
       u.extend(r.nodes[n.offset + 1].box());
@@ -159,13 +176,14 @@ TEST(BvhBuild, CoincidentCentroidsAreSplitByForce) {
   mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
   for (int i = 0; i < 50; ++i) mesh.triangles.push_back(i % 2 ? glm::uvec3{0, 1, 2} : glm::uvec3{0, 3, 4});
   const Inputs in = inputs_of(mesh);  // two centroids, 25 primitives on each
-  for (BvhMethod method : {BvhMethod::kBinnedSah, BvhMethod::kSweepSah}) {
-    BvhConfig config;
+  auto check = [&](auto config, const char* name) {
     config.max_leaf_size = 4;
-    const BvhBuildResult r = build_bvh(method, config, in.bounds, in.centroids);
-    EXPECT_LE(r.stats.leaf_size_histogram.rbegin()->first, 4u) << bvh_method_name(method);
-    EXPECT_EQ(r.stats.references, mesh.size());
-  }
+    const BuildStats stats = stats_of(build_bvh(config, in.bounds, in.centroids));
+    EXPECT_LE(stats.leaf_size_histogram.rbegin()->first, 4u) << name;
+    EXPECT_EQ(stats.references, mesh.size());
+  };
+  check(BvhSahConfig{}, "bvh-sah");
+  check(BvhSweepConfig{}, "bvh-sweep");
 }
 
 }  // namespace

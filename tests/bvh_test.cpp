@@ -1,13 +1,15 @@
 #include "accel/bvh/bvh.h"
-#include "accel/common/sah.h"
-#include "tests/structure_test_helpers.h"
-
-#include <tbb/task_arena.h>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
+
+#include "accel/bvh/sah_split.h"
+#include "accel/common/sah.h"
+#include "tests/structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -73,10 +75,10 @@ TEST(Bvh, AllDuplicatesSplitsToLeafSize) {
 }
 
 /// Structural invariants: depth-first layout, children inside parents, leaves cover a permutation.
-template <BvhMethod M>
+template <template <class> class S>
 void check_structure(const Mesh& mesh) {
   Params params = testing::make_params({{"width", "2"}});
-  Bvh<TrianglePrims, M> bvh(prims_of(mesh), params);
+  S<TrianglePrims> bvh(prims_of(mesh), S<TrianglePrims>::Config::read(params));
   bvh.build();
   const auto& nodes = bvh.nodes();
   ASSERT_FALSE(nodes.empty());
@@ -111,9 +113,9 @@ void check_structure(const Mesh& mesh) {
 
 TEST(Bvh, StructureInvariants) {
   const Mesh mesh = random_soup(2000, 5);
-  check_structure<BvhMethod::kMedian>(mesh);
-  check_structure<BvhMethod::kBinnedSah>(mesh);
-  check_structure<BvhMethod::kSweepSah>(mesh);
+  check_structure<BvhMedian>(mesh);
+  check_structure<BvhSah>(mesh);
+  check_structure<BvhSweep>(mesh);
 }
 
 TEST(Bvh, MedianLeafSizeIsRespected) {
@@ -142,16 +144,20 @@ TEST(Bvh, SameTreeForAnyThreadCount) {
     auto build_in = [&](int threads) {
       tbb::task_arena arena(threads);
       Params params = testing::make_params({{"width", width}});
-      auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh), params);
+      auto bvh = std::make_unique<BvhSah<TrianglePrims>>(prims_of(mesh),
+                                                         BvhSah<TrianglePrims>::Config::read(params));
       arena.execute([&] { bvh->build(); });
       return bvh;
     };
     const auto one = build_in(1), two = build_in(2);
     ASSERT_FALSE(one->nodes().empty() && one->wide_nodes().empty()) << width;
     ASSERT_EQ(one->nodes().size(), two->nodes().size());
-    EXPECT_EQ(std::memcmp(one->nodes().data(), two->nodes().data(), one->nodes().size() * sizeof(BvhNode)), 0);
+    EXPECT_EQ(std::memcmp(one->nodes().data(), two->nodes().data(), one->nodes().size() * sizeof(BvhNode)),
+              0);
     ASSERT_EQ(one->wide_nodes().size(), two->wide_nodes().size());
-    EXPECT_EQ(std::memcmp(one->wide_nodes().data(), two->wide_nodes().data(), one->wide_nodes().size() * sizeof(Bvh8Node)), 0);
+    EXPECT_EQ(std::memcmp(one->wide_nodes().data(), two->wide_nodes().data(),
+                          one->wide_nodes().size() * sizeof(Bvh8Node)),
+              0);
     EXPECT_EQ(one->order(), two->order());
     EXPECT_EQ(one->block_ids(), two->block_ids());
   }
@@ -177,7 +183,8 @@ TEST(Bvh, RejectsBadParams) {
   EXPECT_THROW(make_accelerator("bvh-sah", prims, testing::make_params({{"leaf_size", "4"}})), ParamError);
   EXPECT_THROW(make_accelerator("bvh-median", prims, testing::make_params({{"max_depth", "0"}})), ParamError);
   EXPECT_THROW(make_accelerator("bvh-sweep", prims, testing::make_params({{"bins", "8"}})), ParamError);
-  EXPECT_NO_THROW(make_accelerator("bvh-sah", prims, testing::make_params({{"bins", "32"}, {"traversal_cost", "0.5"}})));
+  EXPECT_NO_THROW(
+      make_accelerator("bvh-sah", prims, testing::make_params({{"bins", "32"}, {"traversal_cost", "0.5"}})));
 }
 
 TEST(Bvh, TopLevelOverInstances) {
@@ -189,6 +196,55 @@ TEST(Bvh, TopLevelOverInstances) {
   box_mesh.triangles = {{0, 1, 2}};
   const auto rays = adversarial_rays(box_mesh, 1500, 31);
   for (const char* name : kBvhs) EXPECT_EQ(testing::count_instance_differences(name, inst, rays), 0u) << name;
+}
+
+/// One bin of Wald's binned builder: the bounds of the primitives whose centroid fell in it, and their count.
+struct SahBin {
+  AABB bounds;
+  uint32_t count = 0;
+
+  /// Adds a primitive with bounds b.
+  void add(const AABB& b) {
+    bounds.extend(b);
+    ++count;
+  }
+};
+
+/// The scalar form of the binned builder's split search over one axis (Wald 2007), the reference its
+/// three-axis SIMD form follows: suffix areas right to left, then every boundary left to right, ranked by
+/// left_area * left_count + right_area * right_count; the cheapest is priced with SahCosts::split and
+/// replaces best when cheaper.
+void best_bin_split(const SahBin* bins, int n, int axis, float parent_area, const SahCosts& costs,
+                    SahSplit& best) {
+  std::array<float, 256> right_area;
+  std::array<uint32_t, 256> right_count;
+  AABB acc;
+  uint32_t cnt = 0;
+  for (int i = n - 1; i > 0; --i) {
+    acc.extend(bins[i].bounds);
+    cnt += bins[i].count;
+    right_area[i] = acc.area();
+    right_count[i] = cnt;
+  }
+  acc = AABB{};
+  cnt = 0;
+  float best_weighted = kInf, best_left_area = 0.0f, best_right_area = 0.0f;
+  int best_i = 0;
+  uint32_t best_left = 0;
+  for (int i = 1; i < n; ++i) {
+    acc.extend(bins[i - 1].bounds);
+    cnt += bins[i - 1].count;
+    if (cnt == 0 || right_count[i] == 0) continue;
+    const float left_area = acc.area();
+    const float weighted = left_area * float(cnt) + right_area[i] * float(right_count[i]);
+    if (weighted < best_weighted) {
+      best_weighted = weighted, best_i = i, best_left = cnt;
+      best_left_area = left_area, best_right_area = right_area[i];
+    }
+  }
+  if (best_i == 0) return;
+  const float c = costs.split(parent_area, best_left_area, best_left, best_right_area, right_count[best_i]);
+  if (c < best.cost) best = {axis, best_i, c};
 }
 
 TEST(Sah, BinSplitFindsTheGap) {

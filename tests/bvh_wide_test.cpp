@@ -1,16 +1,16 @@
 // The 8-wide BVH: its SIMD box test against the scalar one, the four-lane kernel against the scalar
 // kernel (bit for bit), the collapsed tree's invariants and its thread independence.
-#include "accel/core/box_test.h"
-#include "accel/bvh/bvh.h"
-#include "accel/bvh/wide.h"
-#include "accel/core/triangle4.h"
-#include "tests/structure_test_helpers.h"
-
 #include <gtest/gtest.h>
 
 #include <bit>
 #include <cstring>
 #include <random>
+
+#include "accel/bvh/bvh.h"
+#include "accel/bvh/walk8.h"
+#include "accel/core/box_test.h"
+#include "accel/core/triangle4.h"
+#include "tests/structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -24,7 +24,9 @@ std::shared_ptr<const TrianglePrims> prims_of(const Mesh& m) {
   return std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(m));
 }
 
-uint32_t bits(float f) { return std::bit_cast<uint32_t>(f); }
+uint32_t bits(float f) {
+  return std::bit_cast<uint32_t>(f);
+}
 
 /// Random rays with awkward directions: zero and -0 components, axis-parallel, tiny and huge.
 Ray awkward_ray(std::mt19937& rng) {
@@ -47,7 +49,8 @@ TEST(Bvh8, SimdBoxTestEqualsTheScalarOneLaneByLane) {
     for (int k = 0; k < 8; ++k) {
       const bool empty = rng() % 7 == 0;
       for (int a = 0; a < 3; ++a) {
-        float lo = std::round(uniform(rng, -2, 2) * 4) / 4, hi = lo + (rng() % 3 == 0 ? 0.0f : uniform(rng, 0, 2));
+        float lo = std::round(uniform(rng, -2, 2) * 4) / 4,
+              hi = lo + (rng() % 3 == 0 ? 0.0f : uniform(rng, 0, 2));
         node.bounds[a][k] = empty ? kInf : lo;
         node.bounds[3 + a][k] = empty ? -kInf : hi;
       }
@@ -55,7 +58,8 @@ TEST(Bvh8, SimdBoxTestEqualsTheScalarOneLaneByLane) {
     }
     const Ray ray = awkward_ray(rng);
     const Bvh8RayTest test(ray);
-    const float limit = rng() % 2 ? ray.tmax : std::min(ray.tmax, uniform(rng, 0, 2));  // as the walk passes it
+    const float limit =
+        rng() % 2 ? ray.tmax : std::min(ray.tmax, uniform(rng, 0, 2));  // as the walk passes it
     alignas(32) float simd[8], scalar[8];
     const unsigned m1 = test.entries(node, limit, simd), m2 = test.entries_scalar(node, limit, scalar);
     ASSERT_EQ(m1, m2) << "trial " << trial;
@@ -70,9 +74,10 @@ TEST(Bvh8, SimdBoxTestEqualsTheScalarOneLaneByLane) {
       float t0 = ray.tmin, t1 = limit;
       ASSERT_EQ(bool(m1 >> k & 1), node.used(k) && slab_test(node.box(k), RayBoxData(ray), t0, t1))
           << trial << " lane " << k << " org " << ray.org.x << "," << ray.org.y << "," << ray.org.z << " dir "
-          << ray.dir.x << "," << ray.dir.y << "," << ray.dir.z << " t " << ray.tmin << ".." << ray.tmax << " limit " << limit
-          << " box " << node.box(k).lo.x << "," << node.box(k).lo.y << "," << node.box(k).lo.z << " - " << node.box(k).hi.x
-          << "," << node.box(k).hi.y << "," << node.box(k).hi.z << " entry " << simd[k];
+          << ray.dir.x << "," << ray.dir.y << "," << ray.dir.z << " t " << ray.tmin << ".." << ray.tmax
+          << " limit " << limit << " box " << node.box(k).lo.x << "," << node.box(k).lo.y << ","
+          << node.box(k).lo.z << " - " << node.box(k).hi.x << "," << node.box(k).hi.y << ","
+          << node.box(k).hi.z << " entry " << simd[k];
     }
   }
 }
@@ -113,8 +118,7 @@ TEST(Bvh8, FourLaneKernelGivesTheScalarKernelsBits) {
 /// triangles, every triangle sits in exactly one block lane, nodes have 2..8 children.
 TEST(Bvh8, CollapsedTreeInvariants) {
   const Mesh mesh = random_soup(5000, 21);
-  Params params;
-  BvhSah<TrianglePrims> bvh(prims_of(mesh), params);
+  BvhSah<TrianglePrims> bvh(prims_of(mesh), BvhSahConfig{});
   bvh.build();
   const auto& wide = bvh.wide_nodes();
   ASSERT_FALSE(wide.empty());

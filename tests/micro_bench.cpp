@@ -2,16 +2,6 @@
 // structure and generator (single thread, closest hit), and of the builds (2 threads).
 // Sizes from the environment: ACCELBENCH_MICRO_TRIANGLES (default 100000), ACCELBENCH_MICRO_RAYS (100000).
 // Filter with --benchmark_filter, e.g. 'Trace/sphereflake/.*/(bvh-sah|embree)'.
-#include "accel/bvh/bvh.h"
-#include "accel/bvh/wide.h"
-#include "accel/core/triangle4.h"
-#include "accel/core/box_test.h"
-#include "accel/core/registry.h"
-#include "accel/core/triangle.h"
-#include "datasets/generators.h"
-#include "datasets/rays.h"
-#include "harness/target.h"
-
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 
@@ -23,6 +13,16 @@
 #include <string>
 #include <vector>
 
+#include "accel/bvh/walk2.h"
+#include "accel/bvh/walk8.h"
+#include "accel/core/box_test.h"
+#include "accel/core/registry.h"
+#include "accel/core/triangle.h"
+#include "accel/core/triangle4.h"
+#include "datasets/generators.h"
+#include "datasets/rays.h"
+#include "harness/target.h"
+
 namespace ab {
 namespace {
 
@@ -31,7 +31,9 @@ uint64_t env_count(const char* name, uint64_t def) {
   return s ? std::strtoull(s, nullptr, 10) : def;
 }
 
-float uniform(std::mt19937& rng, float lo, float hi) { return lo + (hi - lo) * float(rng() >> 8) * 0x1p-24f; }
+float uniform(std::mt19937& rng, float lo, float hi) {
+  return lo + (hi - lo) * float(rng() >> 8) * 0x1p-24f;
+}
 
 std::vector<Ray> random_rays(size_t n, uint32_t seed) {
   std::mt19937 rng(seed);
@@ -103,7 +105,9 @@ void BM_Bvh8BoxTest(benchmark::State& state) {
   for (const Ray& r : rays) tests.emplace_back(r);
   Bvh8Node node;
   for (int k = 0; k < 8; ++k) {
-    for (int a = 0; a < 3; ++a) node.bounds[a][k] = 0.25f * float(k) * (a == 0), node.bounds[3 + a][k] = 1.0f + 0.25f * float(k) * (a == 0);
+    for (int a = 0; a < 3; ++a)
+      node.bounds[a][k] = 0.25f * float(k) * (a == 0),
+      node.bounds[3 + a][k] = 1.0f + 0.25f * float(k) * (a == 0);
     node.child[k] = node.count[k] = 0;
   }
   alignas(32) float t[8];
@@ -206,28 +210,30 @@ const bool kRegistered = [] {
   for (const char* g : generators) {
     for (const char* kind : {"primary", "incoherent"})
       for (const char* accel : {"bvh-sah", "bvh-sweep", "bvh-median", "grid", "embree"})
-        benchmark::RegisterBenchmark((std::string("BM_Trace/") + g + "/" + kind + "/" + accel).c_str(), BM_Trace, g,
-                                     kind, accel, "")
+        benchmark::RegisterBenchmark((std::string("BM_Trace/") + g + "/" + kind + "/" + accel).c_str(),
+                                     BM_Trace, g, kind, accel, "")
             ->Unit(benchmark::kMillisecond)
             ->MinWarmUpTime(0.2);
     for (const char* kind : {"primary", "incoherent"})
       for (const char* cost : {"0.5", "2", "3"})
         benchmark::RegisterBenchmark(
-            (std::string("BM_Trace/") + g + "/" + kind + "/bvh-sah/traversal_cost=" + cost).c_str(), BM_Trace, g, kind,
-            "bvh-sah", std::string("traversal_cost=") + cost)
+            (std::string("BM_Trace/") + g + "/" + kind + "/bvh-sah/traversal_cost=" + cost).c_str(), BM_Trace,
+            g, kind, "bvh-sah", std::string("traversal_cost=") + cost)
             ->Unit(benchmark::kMillisecond);
     for (const char* kind : {"primary", "incoherent"})
       for (const char* lambda : {"0.5", "0.75", "1", "1.5", "2", "3"})
-        benchmark::RegisterBenchmark((std::string("BM_Trace/") + g + "/" + kind + "/grid/lambda=" + lambda).c_str(),
-                                     BM_Trace, g, kind, "grid", std::string("lambda=") + lambda)
+        benchmark::RegisterBenchmark(
+            (std::string("BM_Trace/") + g + "/" + kind + "/grid/lambda=" + lambda).c_str(), BM_Trace, g, kind,
+            "grid", std::string("lambda=") + lambda)
             ->Unit(benchmark::kMillisecond);
     for (const char* accel : {"bvh-sah", "bvh-sweep", "bvh-median", "grid", "embree"})
-      benchmark::RegisterBenchmark((std::string("BM_Build/") + g + "/" + accel).c_str(), BM_Build, g, accel, "")
+      benchmark::RegisterBenchmark((std::string("BM_Build/") + g + "/" + accel).c_str(), BM_Build, g, accel,
+                                   "")
           ->Unit(benchmark::kMillisecond)
           ->UseManualTime();
     for (const char* lambda : {"0.5", "0.75", "1", "1.5", "2", "3"})
-      benchmark::RegisterBenchmark((std::string("BM_Build/") + g + "/grid/lambda=" + lambda).c_str(), BM_Build, g,
-                                   "grid", std::string("lambda=") + lambda)
+      benchmark::RegisterBenchmark((std::string("BM_Build/") + g + "/grid/lambda=" + lambda).c_str(),
+                                   BM_Build, g, "grid", std::string("lambda=") + lambda)
           ->Unit(benchmark::kMillisecond)
           ->UseManualTime();
   }

@@ -1,15 +1,19 @@
-#include "accel/bvh/build.h"
-
+// The binned SAH BVH builder (bvh-sah).
+#include <immintrin.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
-
-#include <immintrin.h>
 
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <memory>
+
+#include "accel/bvh/build.h"
+#include "accel/bvh/sah_split.h"
+#include "accel/bvh/slots.h"
+#include "accel/common/binning.h"
 
 namespace ab {
 
@@ -73,13 +77,14 @@ struct NodeBounds {
 };
 
 /// The bin of a centre on all three axes at once: int((c - lo) * scale) clamped to [0, bins - 1], the
-/// arithmetic of BinMapping::bin (sah.h) in one vector.
+/// arithmetic of BinMapping::bin (binning.h) in one vector.
 struct BinIndexer {
   __m128 lo, scale;
   __m128i last;
 
   explicit BinIndexer(const BinMapping& m)
-      : lo(_mm_setr_ps(m.lo[0], m.lo[1], m.lo[2], 0.0f)), scale(_mm_setr_ps(m.scale[0], m.scale[1], m.scale[2], 0.0f)),
+      : lo(_mm_setr_ps(m.lo[0], m.lo[1], m.lo[2], 0.0f)),
+        scale(_mm_setr_ps(m.scale[0], m.scale[1], m.scale[2], 0.0f)),
         last(_mm_set1_epi32(m.bins - 1)) {}
   __m128i bins(__m128 c) const {
     const __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
@@ -124,13 +129,16 @@ __m128 areas3(const Box4* box) {
   return _mm_mul_ps(_mm_set1_ps(2.0f), s);
 }
 
-/// best_bin_split (sah.h) for the three axes at once, one per vector lane: the same suffix areas, the same
-/// weighted areas left_area * left_count + right_area * right_count and the same choice (the first
-/// cheapest boundary per axis, then the first cheapest axis), so the tree is the one the scalar form gives.
-/// Axes whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
+/// The cheapest bin boundary over the three axes, one axis per vector lane (Wald 2007): suffix areas right to
+/// left, then prefix areas left to right. Within an axis a boundary is ranked by left_area * left_count +
+/// right_area * right_count (the cost without its constant terms, so no division per boundary); the first
+/// cheapest boundary of each axis is priced with SahCosts::split, and the first cheapest axis wins. Axes
+/// whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
 SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_area, const SahCosts& costs) {
   const int n = bins.nb;
-  auto counts = [&](int k) { return _mm_setr_epi32(int(bins.count[k]), int(bins.count[n + k]), int(bins.count[2 * n + k]), 0); };
+  auto counts = [&](int k) {
+    return _mm_setr_epi32(int(bins.count[k]), int(bins.count[n + k]), int(bins.count[2 * n + k]), 0);
+  };
   auto extend = [&](Box4* acc, int k) {
     for (int a = 0; a < 3; ++a) acc[a].extend(bins.box[a * n + k]);
   };
@@ -152,14 +160,17 @@ SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_
     extend(acc, i - 1);
     cnt = _mm_add_epi32(cnt, counts(i - 1));
     const __m128 la = areas3(acc), ra = right_area[i];
-    const __m128 w = _mm_add_ps(_mm_mul_ps(la, _mm_cvtepi32_ps(cnt)), _mm_mul_ps(ra, _mm_cvtepi32_ps(right_count[i])));
+    const __m128 w =
+        _mm_add_ps(_mm_mul_ps(la, _mm_cvtepi32_ps(cnt)), _mm_mul_ps(ra, _mm_cvtepi32_ps(right_count[i])));
     const __m128i empty_side = _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()),
                                             _mm_cmpeq_epi32(right_count[i], _mm_setzero_si128()));
-    const __m128 better = _mm_andnot_ps(_mm_castsi128_ps(empty_side), _mm_and_ps(axis_ok, _mm_cmplt_ps(w, best_w)));
+    const __m128 better =
+        _mm_andnot_ps(_mm_castsi128_ps(empty_side), _mm_and_ps(axis_ok, _mm_cmplt_ps(w, best_w)));
     best_w = _mm_blendv_ps(best_w, w, better);
     best_la = _mm_blendv_ps(best_la, la, better);
     best_ra = _mm_blendv_ps(best_ra, ra, better);
-    best_i = _mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(best_i), _mm_castsi128_ps(_mm_set1_epi32(i)), better));
+    best_i = _mm_castps_si128(
+        _mm_blendv_ps(_mm_castsi128_ps(best_i), _mm_castsi128_ps(_mm_set1_epi32(i)), better));
     best_lc = _mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(best_lc), _mm_castsi128_ps(cnt), better));
   }
   alignas(16) int32_t bi[4], lc[4], total[4];
@@ -209,7 +220,7 @@ struct BinnedSplit {
 // parallel; the tree is the same for any number of threads.
 class BinnedBuilder {
  public:
-  BinnedBuilder(const BvhConfig& config, std::span<const AABB> bounds);
+  BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds);
 
   /// Builds the tree and returns the flattened result.
   BvhBuildResult run();
@@ -217,12 +228,13 @@ class BinnedBuilder {
  private:
   void build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer);
   void make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer);
-  BinnedSplit find_split(const BinRef* refs, uint32_t b, uint32_t e, const NodeBounds& nb, const BinMapping& map) const;
+  BinnedSplit find_split(const BinRef* refs, uint32_t b, uint32_t e, const NodeBounds& nb,
+                         const BinMapping& map) const;
   void partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis, int position,
                  const BinMapping& map, Box4& left_c, Box4& right_c);
   NodeBounds root_bounds() const;
 
-  const BvhConfig& config_;
+  const BvhSahConfig& config_;
   size_t n_;
   /// The references (buffer 0, which holds the final leaf order) and the second partition buffer;
   /// uninitialized allocations (every element is written before it is read).
@@ -230,9 +242,10 @@ class BinnedBuilder {
   BvhSlots slots_;
 };
 
-BinnedBuilder::BinnedBuilder(const BvhConfig& config, std::span<const AABB> bounds)
-    : config_(config), n_(bounds.size()), buffers_{std::make_unique_for_overwrite<BinRef[]>(n_),
-                                                  std::make_unique_for_overwrite<BinRef[]>(n_)},
+BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds)
+    : config_(config),
+      n_(bounds.size()),
+      buffers_{std::make_unique_for_overwrite<BinRef[]>(n_), std::make_unique_for_overwrite<BinRef[]>(n_)},
       slots_(n_) {
   BinRef* refs = buffers_[0].get();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
@@ -299,8 +312,8 @@ void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& 
     right.box = split.right;
     m = b + split.left_count;
     child_buffer = 1 - buffer;
-    partition(refs, buffers_[child_buffer].get(), b, m, e, split.sah.axis, split.sah.position, map, left.centroids,
-              right.centroids);
+    partition(refs, buffers_[child_buffer].get(), b, m, e, split.sah.axis, split.sah.position, map,
+              left.centroids, right.centroids);
   } else {  // forced split in the middle of the current order
     m = b + decision;
     for (uint32_t k = b; k < e; ++k) {
@@ -326,7 +339,8 @@ BinnedSplit BinnedBuilder::find_split(const BinRef* refs, uint32_t b, uint32_t e
   const BinIndexer ix(map);
   BinnedSplit out;
   auto evaluate = [&](const BinSet& bins) {
-    const __m128 axis_ok = _mm_cmpgt_ps(_mm_setr_ps(map.scale[0], map.scale[1], map.scale[2], 0.0f), _mm_setzero_ps());
+    const __m128 axis_ok =
+        _mm_cmpgt_ps(_mm_setr_ps(map.scale[0], map.scale[1], map.scale[2], 0.0f), _mm_setzero_ps());
     out.sah = best_split_three_axes(bins, axis_ok, nb.box.area(), config_.costs);
     if (out.sah.axis < 0) return;
     const int base = out.sah.axis * bins.nb;
@@ -371,7 +385,7 @@ void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint3
 
 }  // namespace
 
-BvhBuildResult build_bvh_binned(const BvhConfig& config, std::span<const AABB> bounds) {
+BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {
   return BinnedBuilder(config, bounds).run();
 }
 

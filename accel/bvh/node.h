@@ -1,15 +1,15 @@
-// The nodes of the binary BVH: 32 bytes each, siblings paired in one 64-byte line.
+// The node of the binary BVH: 32 bytes, siblings paired in one 64-byte line.
 #pragma once
 
-#include "accel/core/aabb.h"
-
 #include <cstdint>
-#include <new>
 #include <vector>
+
+#include "accel/bvh/cache_line_allocator.h"
+#include "accel/core/aabb.h"
 
 namespace ab {
 
-/// Largest allowed max_depth (the traversal stack holds one entry per level).
+/// Largest allowed max_depth (the traversal stacks hold one entry per level).
 inline constexpr int kBvhMaxDepth = 120;
 
 /// One flattened BVH node. Interior (count == 0): the children are the sibling pair `offset`, `offset + 1`
@@ -17,10 +17,10 @@ inline constexpr int kBvhMaxDepth = 120;
 /// [offset, offset + count) of the leaf-ordered reference array. The layout (lo, offset, hi, count) lets
 /// a node load as one 32-byte vector. Node 0 is the root, node 1 is padding, pairs start at 2.
 struct alignas(32) BvhNode {
-  float lo[3];
-  uint32_t offset;
-  float hi[3];
-  uint32_t count;
+  float lo[3];      ///< box minimum
+  uint32_t offset;  ///< interior: the children's pair; leaf: the first primitive of leaf order
+  float hi[3];      ///< box maximum
+  uint32_t count;   ///< primitives of a leaf, 0 for an interior node
 
   /// True for a leaf.
   bool is_leaf() const { return count > 0; }
@@ -29,19 +29,7 @@ struct alignas(32) BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32, "BVH nodes are 32 bytes");
 
-/// Allocator aligning the node array to 64 bytes, so each sibling pair shares one cache line.
-template <class T>
-struct CacheLineAllocator {
-  using value_type = T;
-  CacheLineAllocator() = default;
-  template <class U>
-  CacheLineAllocator(const CacheLineAllocator<U>&) {}
-  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
-  void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(64)); }
-  bool operator==(const CacheLineAllocator&) const { return true; }
-};
-
-/// The node array of a BVH.
+/// The node array of a binary BVH.
 using BvhNodeArray = std::vector<BvhNode, CacheLineAllocator<BvhNode>>;
 
 }  // namespace ab

@@ -1,5 +1,4 @@
-#include "accel/bvh/build.h"
-
+// The full-sweep SAH BVH builder (bvh-sweep).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -8,6 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+
+#include "accel/bvh/build.h"
+#include "accel/bvh/sah_split.h"
+#include "accel/bvh/slots.h"
 
 namespace ab {
 
@@ -37,7 +40,7 @@ struct SortKey {
 // number of threads: every decision depends only on the node's range.
 class SweepBuilder {
  public:
-  SweepBuilder(const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids);
+  SweepBuilder(const BvhSweepConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids);
 
   /// Builds the tree and returns the flattened result.
   BvhBuildResult run();
@@ -49,7 +52,7 @@ class SweepBuilder {
   void sweep_axis(int a, uint32_t b, uint32_t e, float area, SahSplit& best);
   void partition(int a, uint32_t b, uint32_t m, uint32_t e, AABB& left, AABB& right);
 
-  const BvhConfig& config_;
+  const BvhSweepConfig& config_;
   std::span<const vec3> centroids_;
   std::array<std::vector<SweepRef>, 3> lists_;  ///< per axis, each node's range sorted by (centroid, id)
   std::vector<SweepRef> scratch_;               ///< partition buffer (ranges of parallel nodes are disjoint)
@@ -59,9 +62,14 @@ class SweepBuilder {
   AABB root_box_;
 };
 
-SweepBuilder::SweepBuilder(const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids)
-    : config_(config), centroids_(centroids), scratch_(bounds.size()), right_area_(bounds.size()),
-      goes_left_(bounds.size()), slots_(bounds.size()) {
+SweepBuilder::SweepBuilder(const BvhSweepConfig& config, std::span<const AABB> bounds,
+                           std::span<const vec3> centroids)
+    : config_(config),
+      centroids_(centroids),
+      scratch_(bounds.size()),
+      right_area_(bounds.size()),
+      goes_left_(bounds.size()),
+      slots_(bounds.size()) {
   for (const AABB& b : bounds) root_box_.extend(b);
   for (int a = 0; a < 3; ++a) sort_axis(a, bounds);
 }
@@ -168,7 +176,8 @@ void SweepBuilder::partition(int a, uint32_t b, uint32_t m, uint32_t e, AABB& le
 
 }  // namespace
 
-BvhBuildResult build_bvh_sweep(const BvhConfig& config, std::span<const AABB> bounds, std::span<const vec3> centroids) {
+BvhBuildResult build_bvh(const BvhSweepConfig& config, std::span<const AABB> bounds,
+                         std::span<const vec3> centroids) {
   return SweepBuilder(config, bounds, centroids).run();
 }
 
