@@ -127,29 +127,38 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
     }
   }
 
-  /// Splits the current cell at its mid-plane of axis cur.level; continues into the first half met.
+  /// Splits the current cell at its mid-plane of axis cur.level: continues into the first half the ray meets
+  /// and stacks the second when the interval reaches it too; false when it reaches neither.
   [[gnu::always_inline]] static bool split_cell(Cell& cur, const PlaneRay& r, Stack& stack) {
     const int a = cur.level;
     const float mid = 0.5f * (cur.box.lo[a] + cur.box.hi[a]);
     const PlaneVisit v = split_interval(r.cross(a, mid), cur.t0, cur.t1);
-    Cell below = cur, above = cur;
-    below.level = above.level = a + 1;
-    below.box.hi[a] = mid;
-    above.box.lo[a] = mid;
-    above.octant |= 1 << a;
-    Cell& first = v.below_first ? below : above;
-    Cell& second = v.below_first ? above : below;
-    first.t1 = v.first_t1;
-    second.t0 = v.second_t0;
-    if (v.visit_first && v.visit_second) stack.push(second);
+    if (!v.visit_first && !v.visit_second) return false;
+    cur.level = a + 1;
+    if (v.visit_first && v.visit_second) {
+      Cell second = cur;
+      second.t0 = v.second_t0;
+      take_half(second, a, mid, v.below_first);
+      stack.push(second);
+    }
     if (v.visit_first) {
-      cur = first;
-    } else if (v.visit_second) {
-      cur = second;
+      cur.t1 = v.first_t1;
+      take_half(cur, a, mid, !v.below_first);
     } else {
-      return false;
+      cur.t0 = v.second_t0;
+      take_half(cur, a, mid, v.below_first);
     }
     return true;
+  }
+
+  /// Narrows cell c to its half above (or below) the mid-plane `mid` of axis a.
+  [[gnu::always_inline]] static void take_half(Cell& c, int a, float mid, bool above) {
+    if (above) {
+      c.box.lo[a] = mid;
+      c.octant |= 1 << a;
+    } else {
+      c.box.hi[a] = mid;
+    }
   }
 
   std::shared_ptr<const P> prims_;
