@@ -57,6 +57,7 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
   friend class SpatialTreeQueries<BspTree<P>>;
 
  public:
+  /// The primitive set.
   using Prims = P;
   /// The BSP tree's configuration (config.h).
   using Config = BspConfig;
@@ -64,6 +65,7 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
   /// Over prims with config; the build is separate.
   BspTree(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {}
 
+  /// Bounds of the primitives.
   AABB bounds() const override { return prims_->bounds(); }
 
  protected:

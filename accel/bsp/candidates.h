@@ -18,8 +18,8 @@ namespace ab {
 
 /// A plane dot(n, x) = d with a unit normal; "below" is dot(n, x) < d.
 struct BspPlane {
-  vec3 n{1.0f, 0.0f, 0.0f};
-  float d = 0.0f;
+  vec3 n{1.0f, 0.0f, 0.0f};  ///< unit normal
+  float d = 0.0f;            ///< offset along n
 
   /// Signed distance of p (positive above).
   float distance(const vec3& p) const { return glm::dot(n, p) - d; }

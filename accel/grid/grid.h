@@ -32,10 +32,10 @@ struct GridConfig {
 
 /// The geometry of a grid: its box, resolution and cell size. Cell (x, y, z) spans planes x..x+1 etc.
 struct GridLayout {
-  AABB box;
-  std::array<int, 3> res{0, 0, 0};
-  vec3 cell_size{0.0f};
-  vec3 inv_cell_size{0.0f};  ///< 0 on a flat axis (which always has one cell)
+  AABB box;                         ///< the grid box
+  std::array<int, 3> res{0, 0, 0};  ///< cells per axis
+  vec3 cell_size{0.0f};             ///< extent of a cell per axis
+  vec3 inv_cell_size{0.0f};         ///< 0 on a flat axis (which always has one cell)
 
   /// Number of cells.
   size_t cells() const { return size_t(res[0]) * size_t(res[1]) * size_t(res[2]); }
@@ -64,8 +64,8 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
 
 /// Cells in compressed rows: the ids of cell c are ids[offsets[c] .. offsets[c+1]), ascending.
 struct GridCells {
-  std::vector<uint32_t> offsets;
-  std::vector<uint32_t> ids;
+  std::vector<uint32_t> offsets;  ///< cells + 1 row starts
+  std::vector<uint32_t> ids;      ///< the cells' primitive ids, cell after cell
 };
 
 /// Appends to `out` the cells primitive `id` goes into, each as (cell index << 32) | id, in ascending
@@ -116,9 +116,9 @@ class Mailbox {
 /// The state of a 3D-DDA walk: the current cell and, per axis, the step and the ray parameter of the
 /// next plane crossing (computed directly from the plane position each time, never accumulated).
 struct GridWalk {
-  int cell[3];
-  int step[3];
-  float t_next[3];
+  int cell[3];      ///< current cell coordinates
+  int step[3];      ///< +1, -1 or 0 per axis
+  float t_next[3];  ///< parameter of the next plane crossing per axis
 
   /// Starts the walk at parameter t0 (the ray's entry into the grid box).
   GridWalk(const GridLayout& g, const Ray& ray, const RayBoxData& rd, float t0);
@@ -145,6 +145,7 @@ void gather_grid_stats(const GridLayout& layout, const GridCells& cells, const G
 template <class P>
 class Grid final : public AcceleratorBase<Grid<P>> {
  public:
+  /// The primitive set.
   using Prims = P;
   /// The grid's configuration.
   using Config = GridConfig;
@@ -152,6 +153,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   /// Over prims with config; the build is separate (build()).
   Grid(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {}
 
+  /// Bounds of the primitives.
   AABB bounds() const override { return prims_->bounds(); }
   /// The grid's geometry (for tests).
   const GridLayout& layout() const { return layout_; }

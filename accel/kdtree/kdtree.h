@@ -67,6 +67,7 @@ class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
   friend class SpatialTreeQueries<KdTree<P, M>>;
 
  public:
+  /// The primitive set.
   using Prims = P;
   /// KdMedianConfig or KdSahConfig (config.h).
   using Config = std::conditional_t<M == KdMethod::kSah, KdSahConfig, KdMedianConfig>;
@@ -74,6 +75,7 @@ class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
   /// Over prims with config; the build is separate.
   KdTree(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {}
 
+  /// Bounds of the primitives.
   AABB bounds() const override { return prims_->bounds(); }
 
  protected:

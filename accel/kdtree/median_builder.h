@@ -23,8 +23,8 @@ class KdMedianBuilder {
  public:
   /// A primitive in a node: its id and its bounds clipped to the node box.
   struct Ref {
-    uint32_t id;
-    AABB cb;
+    uint32_t id;  ///< primitive id
+    AABB cb;      ///< its bounds clipped to the node box
   };
 
   /// Builder over prims with the tree's configuration and its resolved depth limit (> 0).

@@ -32,8 +32,8 @@ namespace ab {
 
 /// A sweep event: position along one axis and (primitive's index in its node << 2 | type).
 struct KdEvent {
-  float pos;
-  uint32_t key;
+  float pos;     ///< position along the axis
+  uint32_t key;  ///< local index << 2 | type
 
   /// Event types, in the order the sweep needs at one position: ends, planars, starts.
   enum Type : uint32_t { kEnd = 0, kPlanar = 1, kStart = 2 };
@@ -51,9 +51,9 @@ struct KdEvent {
 
 /// A node under construction: box, primitive ids and the sorted events of each axis.
 struct KdEventNode {
-  AABB box;
-  std::vector<uint32_t> ids;
-  std::array<std::vector<KdEvent>, 3> events;
+  AABB box;                                    ///< the node's box
+  std::vector<uint32_t> ids;                   ///< its primitives
+  std::array<std::vector<KdEvent>, 3> events;  ///< per axis, sorted
 };
 
 /// Appends the events of a primitive with clipped bounds cb as local index `local`.
@@ -70,11 +70,11 @@ inline void add_kd_events(const AABB& cb, uint32_t local, std::array<std::vector
 
 /// Result of the sweep.
 struct KdSahPlane {
-  int axis = -1;  ///< -1: no plane inside the box
-  float pos = 0.0f;
-  float cost = kInf;
-  bool planar_left = true;  ///< planar primitives at pos are counted on the left
-  uint32_t n_left = 0, n_right = 0;
+  int axis = -1;                     ///< -1: no plane inside the box
+  float pos = 0.0f;                  ///< plane position
+  float cost = kInf;                 ///< its SAH cost
+  bool planar_left = true;           ///< planar primitives at pos are counted on the left
+  uint32_t n_left = 0, n_right = 0;  ///< primitives on each side
 };
 
 /// Area terms of the children of a node box along one axis, so that each plane costs a few flops.

@@ -57,6 +57,7 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
   friend class SpatialTreeQueries<Octree<P>>;
 
  public:
+  /// The primitive set.
   using Prims = P;
   /// The octree's configuration (config.h).
   using Config = OctreeConfig;
@@ -64,6 +65,7 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
   /// Over prims with config; the build is separate.
   Octree(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {}
 
+  /// Bounds of the primitives.
   AABB bounds() const override { return prims_->bounds(); }
 
  protected:
