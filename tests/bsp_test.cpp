@@ -1,11 +1,11 @@
 // BSP tree: cutting a cell box by a plane, traversal against brute on oblique flat geometry and on rays
 // lying in oblique planes, use of oblique planes, traversal cost on slanted slivers, thread independence.
 #include "accel/bsp/bsp.h"
-#include "structure_test_helpers.h"
-
-#include <tbb/global_control.h>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -133,7 +133,8 @@ TEST(Bsp, MatchesBruteOnAdversarialMeshesAndInstances) {
   EXPECT_EQ(count_differences("bsp", mesh, adversarial_rays(mesh, 3000, 7)), 0u);
   EXPECT_EQ(count_differences("bsp", Mesh{}, adversarial_rays(Mesh{}, 100, 7)), 0u);
   auto inst = testing::make_instances(random_soup(200, 2), "bsp", 7);
-  EXPECT_EQ(testing::count_instance_differences("bsp", inst, adversarial_rays(random_soup(50, 1), 2000, 6)), 0u);
+  EXPECT_EQ(testing::count_instance_differences("bsp", inst, adversarial_rays(random_soup(50, 1), 2000, 6)),
+            0u);
 }
 
 TEST(Bsp, UsesObliquePlanesAndTestsFewerTrianglesThanKdTreeOnSlantedSlivers) {
@@ -177,8 +178,8 @@ TEST(Bsp, StatisticsAndThreadIndependence) {
   EXPECT_EQ(stored, one.nodes - one.empty_leaves);
   const bool copies = one.extra.at("leaf_copies").get<bool>();
   EXPECT_EQ(copies, one.references <= 3 * one.primitives);
-  EXPECT_EQ(one.bytes,
-            stored * 8 + (one.nodes - one.leaves) * 16 + one.references * (4 + (copies ? sizeof(Triangle) : 0)));
+  EXPECT_EQ(one.bytes, stored * 8 + (one.nodes - one.leaves) * 16 +
+                           one.references * (4 + (copies ? sizeof(Triangle) : 0)));
 }
 
 TEST(Bsp, RejectsBadParameters) {

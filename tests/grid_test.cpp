@@ -1,11 +1,11 @@
 #include "accel/grid/grid.h"
-#include "tests/structure_test_helpers.h"
-
-#include <tbb/task_arena.h>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+
+#include "tests/structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -79,7 +79,7 @@ TEST(Grid, ExactInsertionBeatsBoundsInsertion) {
   m.vertices = {{0, 0, 0}, {1, 1, 1}, {1.0f, 1.0f, 0.98f}, {0, 0, 1}, {0.01f, 0, 1}, {0, 0.01f, 1}};
   m.triangles = {{0, 1, 2}, {3, 4, 5}};
   Params params = testing::make_params({{"lambda", "8"}, {"max_cells", "1000"}});
-  Grid<TrianglePrims> grid(prims_of(m), params);
+  Grid<TrianglePrims> grid(prims_of(m), GridConfig::read(params));
   grid.build();
   const size_t cells = grid.layout().cells();
   EXPECT_GT(cells, 100u);
@@ -96,30 +96,34 @@ std::pair<GridCells, GridCells> both_insertions(const Mesh& mesh, double lambda)
   std::vector<AABB> boxes;
   for (size_t i = 0; i < prims.size(); ++i) boxes.push_back(prims.bounds(i));
   GridCells voxelized = build_grid_cells(layout, prims.size(), triangle_inserter(layout, prims.triangles()));
-  GridCells tested = build_grid_cells(layout, prims.size(), box_test_inserter(layout, boxes, [&](uint32_t i, const AABB& b) {
-                                        return prims.overlaps(i, b);
-                                      }));
+  GridCells tested = build_grid_cells(
+      layout, prims.size(),
+      box_test_inserter(layout, boxes, [&](uint32_t i, const AABB& b) { return prims.overlaps(i, b); }));
   return {std::move(voxelized), std::move(tested)};
 }
 
 TEST(Grid, VoxelizationKeepsEveryCellOfTheExactTest) {
   Mesh diagonal;  // long thin triangles across many cells, one lying in a cell plane
-  diagonal.vertices = {{0, 0, 0}, {1, 1, 1}, {1.0f, 1.0f, 0.98f}, {0, 0, 1}, {0.01f, 0, 1}, {0, 0.01f, 1},
-                       {0, 0.5f, 0}, {1, 0.5f, 0}, {1, 0.5f, 1}};
+  diagonal.vertices = {{0, 0, 0},     {1, 1, 1},    {1.0f, 1.0f, 0.98f}, {0, 0, 1},   {0.01f, 0, 1},
+                       {0, 0.01f, 1}, {0, 0.5f, 0}, {1, 0.5f, 0},        {1, 0.5f, 1}};
   diagonal.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
-  const Mesh meshes[] = {random_soup(3000, 41, 0.1f), random_soup(500, 42, 0.6f), adversarial_mesh(12), diagonal};
+  const Mesh meshes[] = {random_soup(3000, 41, 0.1f), random_soup(500, 42, 0.6f), adversarial_mesh(12),
+                         diagonal};
   for (const Mesh& mesh : meshes) {
     for (double lambda : {0.5, 2.0, 5.0}) {
       const auto [voxelized, tested] = both_insertions(mesh, lambda);
       size_t lost = 0;
       for (size_t c = 0; c + 1 < tested.offsets.size(); ++c) {
-        const auto t0 = tested.ids.begin() + tested.offsets[c], t1 = tested.ids.begin() + tested.offsets[c + 1];
-        const auto v0 = voxelized.ids.begin() + voxelized.offsets[c], v1 = voxelized.ids.begin() + voxelized.offsets[c + 1];
+        const auto t0 = tested.ids.begin() + tested.offsets[c],
+                   t1 = tested.ids.begin() + tested.offsets[c + 1];
+        const auto v0 = voxelized.ids.begin() + voxelized.offsets[c],
+                   v1 = voxelized.ids.begin() + voxelized.offsets[c + 1];
         lost += !std::includes(v0, v1, t0, t1);
       }
       EXPECT_EQ(lost, 0u) << "lambda " << lambda;
       EXPECT_GE(voxelized.ids.size(), tested.ids.size());
-      EXPECT_LE(voxelized.ids.size(), tested.ids.size() * 103 / 100 + 8) << "lambda " << lambda;  // only the margin's extra
+      EXPECT_LE(voxelized.ids.size(), tested.ids.size() * 103 / 100 + 8)
+          << "lambda " << lambda;  // only the margin's extra
     }
   }
 }
@@ -128,8 +132,7 @@ TEST(Grid, CellsAreDeterministicAndSorted) {
   const Mesh mesh = random_soup(20000, 3, 0.03f);
   auto build_in = [&](int threads) {
     tbb::task_arena arena(threads);
-    Params params;
-    auto grid = std::make_unique<Grid<TrianglePrims>>(prims_of(mesh), params);
+    auto grid = std::make_unique<Grid<TrianglePrims>>(prims_of(mesh), GridConfig{});
     arena.execute([&] { grid->build(); });
     return grid;
   };

@@ -1,13 +1,15 @@
 // k-d trees (kdtree-median, kdtree-sah): node encoding, the plane step, flat geometry lying in split
 // planes, rays lying in split planes, statistics, thread-count independence and parameter checks.
-#include "accel/common/spatial_tree.h"
 #include "accel/kdtree/kdtree.h"
-#include "accel/common/split_plane.h"
-#include "structure_test_helpers.h"
-
-#include <tbb/global_control.h>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "accel/common/depth_limit.h"
+#include "accel/common/empty_leaves.h"
+#include "accel/common/split_plane.h"
+#include "accel/kdtree/node.h"
+#include "structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -76,11 +78,11 @@ TEST(KdNode, EncodesLeavesAndInteriorNodes) {
   EXPECT_EQ(inner.axis(), 2);
   EXPECT_EQ(inner.split(), -1.25f);
   EXPECT_EQ(inner.above(), 77u);
-  inner.rebase(10, 1000);
+  inner.rebase({.node = 10, .ref = 1000});
   EXPECT_EQ(inner.above(), 87u);
   EXPECT_EQ(inner.split(), -1.25f);
   KdNode moved = leaf;
-  moved.rebase(10, 1000);
+  moved.rebase({.node = 10, .ref = 1000});
   EXPECT_EQ(moved.first(), 1123u);
   EXPECT_EQ(moved.count(), 45u);
 }
@@ -93,7 +95,7 @@ TEST(KdNode, FlagsEmptyChildrenAndKeepsThemThroughRebase) {
   EXPECT_FALSE(inner.above_empty());
   EXPECT_EQ(inner.above(), (1u << 28) - 1);
   KdNode other = KdNode::interior(0, 2.0f, 5, false, true);
-  other.rebase(3, 100);
+  other.rebase({.node = 3, .ref = 100});
   EXPECT_FALSE(other.below_empty());
   EXPECT_TRUE(other.above_empty());
   EXPECT_EQ(other.above(), 8u);
@@ -102,9 +104,9 @@ TEST(KdNode, FlagsEmptyChildrenAndKeepsThemThroughRebase) {
 TEST(KdNode, DropEmptyLeavesFlagsThemInTheParents) {
   // Depth-first: 0 splits x (below 1, above 4); 1 splits y (below 2: empty, above 3: leaf);
   // 4 splits z (below 5: leaf, above 6: empty).
-  std::vector<KdNode> nodes{KdNode::interior(0, 0.0f, 4), KdNode::interior(1, 1.0f, 3), KdNode::leaf(0, 0),
-                            KdNode::leaf(0, 2),           KdNode::interior(2, 2.0f, 6), KdNode::leaf(2, 1),
-                            KdNode::leaf(0, 0)};
+  std::vector<KdNode> nodes{
+      KdNode::interior(0, 0.0f, 4), KdNode::interior(1, 1.0f, 3), KdNode::leaf(0, 0), KdNode::leaf(0, 2),
+      KdNode::interior(2, 2.0f, 6), KdNode::leaf(2, 1),           KdNode::leaf(0, 0)};
   drop_empty_leaves(nodes);
   ASSERT_EQ(nodes.size(), 5u);
   EXPECT_FALSE(nodes[0].below_empty() || nodes[0].above_empty());
@@ -123,43 +125,51 @@ TEST(KdNode, DropEmptyLeavesFlagsThemInTheParents) {
   EXPECT_EQ(root.size(), 1u);
 }
 
-TEST(SplitPlane, AxisRayCrossingsAreWidenedAndZeroDirectionsNeedNoBranch) {
+TEST(SplitPlane, AxisPlaneCrossingsAreWidenedAndZeroDirectionsNeedNoBranch) {
   Ray ray;
   ray.org = {0.0f, 1.0f, 2.0f};
   ray.dir = {0.5f, 0.0f, -0.0f};
-  const AxisRay r(ray, 0.0f);
-  const AxisCrossing x = r.cross(0, 1.0f);  // crossing at t = 2, below side first
+  const PlaneRay r(ray, 0.0f);
+  const PlaneCrossing x = r.cross(0, 1.0f);  // crossing at t = 2, below side first
   EXPECT_TRUE(x.below_first);
   EXPECT_LT(x.near, 2.0f);
   EXPECT_GT(x.far, 2.0f);
   // With a positional margin, a crossing at (almost) t = 0 is widened by margin / |dir| both ways.
-  const AxisRay m(ray, 0.01f);
-  const AxisCrossing at_origin = m.cross(0, 1e-9f);
+  const PlaneRay m(ray, 0.01f);
+  const PlaneCrossing at_origin = m.cross(0, 1e-9f);
   EXPECT_LE(at_origin.near, -0.019f);
   EXPECT_GE(at_origin.far, 0.019f);
   EXPECT_FALSE(m.cross(1, 1.005f).near > 10.0f);  // parallel within the margin: both sides
   EXPECT_TRUE(m.cross(1, 0.5f).far < 0.0f);       // parallel beyond it: one side
-  const AxisCrossing above = r.cross(1, 0.5f);  // parallel, origin above: never reaches the below side
+  const PlaneCrossing above = r.cross(1, 0.5f);   // parallel, origin above: never reaches the below side
   EXPECT_TRUE(above.below_first);
-  EXPECT_TRUE(above.far < 0.0f);  // -inf: the first (below) side is skipped
-  const AxisCrossing behind = r.cross(2, 3.0f);  // -0 direction: above first; origin below the plane
+  EXPECT_TRUE(above.far < 0.0f);                  // -inf: the first (below) side is skipped
+  const PlaneCrossing behind = r.cross(2, 3.0f);  // -0 direction: above first; origin below the plane
   EXPECT_FALSE(behind.below_first);
-  EXPECT_TRUE(behind.far < 0.0f);  // the above side is never reached
-  const AxisCrossing in_plane = r.cross(1, 1.0f);  // origin in the plane: NaN, both sides visited
+  EXPECT_TRUE(behind.far < 0.0f);                   // the above side is never reached
+  const PlaneCrossing in_plane = r.cross(1, 1.0f);  // origin in the plane: NaN, both sides visited
   EXPECT_FALSE(in_plane.near > 10.0f);
   EXPECT_FALSE(in_plane.far < 0.0f);
 }
 
+/// The plane step at the plane x = split of a ray with origin x = org and direction x = dir.
+PlaneVisit split_at_axis_plane(float org, float dir, float split, float t0, float t1) {
+  Ray ray;
+  ray.org = {org, 0.0f, 0.0f};
+  ray.dir = {dir, 1.0f, 1.0f};
+  return split_interval(PlaneRay(ray, 0.0f).cross(0, split), t0, t1);
+}
+
 TEST(SplitPlane, ParallelRaysStayOnTheirSideAndInPlaneRaysSeeBoth) {
-  const PlaneVisit below = split_at_axis_plane(0.0f, 0.0f, kInf, 1.0f, 0.0f, 10.0f);
-  EXPECT_TRUE(below.first_below);
+  const PlaneVisit below = split_at_axis_plane(0.0f, 0.0f, 1.0f, 0.0f, 10.0f);
+  EXPECT_TRUE(below.below_first);
   EXPECT_TRUE(below.visit_first);
   EXPECT_FALSE(below.visit_second);
-  const PlaneVisit above = split_at_axis_plane(2.0f, -0.0f, -kInf, 1.0f, 0.0f, 10.0f);
-  EXPECT_FALSE(above.first_below);
+  const PlaneVisit above = split_at_axis_plane(2.0f, -0.0f, 1.0f, 0.0f, 10.0f);
+  EXPECT_FALSE(above.below_first);
   EXPECT_TRUE(above.visit_first);
   EXPECT_FALSE(above.visit_second);
-  const PlaneVisit in = split_at_axis_plane(1.0f, 0.0f, kInf, 1.0f, 0.0f, 10.0f);
+  const PlaneVisit in = split_at_axis_plane(1.0f, 0.0f, 1.0f, 0.0f, 10.0f);
   EXPECT_TRUE(in.visit_first && in.visit_second);
   EXPECT_EQ(in.first_t1, 10.0f);
   EXPECT_EQ(in.second_t0, 0.0f);
@@ -167,18 +177,18 @@ TEST(SplitPlane, ParallelRaysStayOnTheirSideAndInPlaneRaysSeeBoth) {
 
 TEST(SplitPlane, CrossingRaysGetWidenedHalves) {
   // Origin below, moving up: below first, crossing at t = 2.
-  const PlaneVisit up = split_at_axis_plane(0.0f, 0.5f, 2.0f, 1.0f, 0.0f, 10.0f);
-  EXPECT_TRUE(up.first_below);
+  const PlaneVisit up = split_at_axis_plane(0.0f, 0.5f, 1.0f, 0.0f, 10.0f);
+  EXPECT_TRUE(up.below_first);
   EXPECT_TRUE(up.visit_first && up.visit_second);
   EXPECT_GT(up.first_t1, 2.0f);
   EXPECT_LT(up.second_t0, 2.0f);
   // Moving down from below: the plane is behind (t = -2); only the below side is ahead.
-  const PlaneVisit down = split_at_axis_plane(0.0f, -0.5f, -2.0f, 1.0f, 0.0f, 10.0f);
-  EXPECT_FALSE(down.first_below);
+  const PlaneVisit down = split_at_axis_plane(0.0f, -0.5f, 1.0f, 0.0f, 10.0f);
+  EXPECT_FALSE(down.below_first);
   EXPECT_FALSE(down.visit_first);
   EXPECT_TRUE(down.visit_second);
   // Interval entirely before the crossing.
-  const PlaneVisit early = split_at_axis_plane(0.0f, 0.5f, 2.0f, 1.0f, 0.0f, 1.0f);
+  const PlaneVisit early = split_at_axis_plane(0.0f, 0.5f, 1.0f, 0.0f, 1.0f);
   EXPECT_TRUE(early.visit_first);
   EXPECT_FALSE(early.visit_second);
 }
@@ -193,8 +203,8 @@ TEST(KdTree, MatchesBruteOnFlatGeometryInSplitPlanes) {
     EXPECT_EQ(count_differences(name, mesh, rays, {{"max_depth", "3"}}), 0u) << name;
   }
   EXPECT_EQ(count_differences("kdtree-median", mesh, rays, {{"leaf_size", "1"}, {"axis", "cycle"}}), 0u);
-  EXPECT_EQ(count_differences("kdtree-sah", mesh, rays, {{"intersection_cost", "20"}, {"empty_bonus", "0.9"}}),
-            0u);
+  EXPECT_EQ(
+      count_differences("kdtree-sah", mesh, rays, {{"intersection_cost", "20"}, {"empty_bonus", "0.9"}}), 0u);
 }
 
 TEST(KdTree, MatchesBruteOnAdversarialMeshesAndInstances) {
@@ -209,7 +219,8 @@ TEST(KdTree, MatchesBruteOnAdversarialMeshesAndInstances) {
   for (const char* name : kKdNames) {
     EXPECT_EQ(count_differences(name, mesh, rays), 0u) << name;
     auto inst = testing::make_instances(random_soup(200, 9), name, 6);
-    EXPECT_EQ(testing::count_instance_differences(name, inst, adversarial_rays(random_soup(50, 1), 2000, 4)), 0u)
+    EXPECT_EQ(testing::count_instance_differences(name, inst, adversarial_rays(random_soup(50, 1), 2000, 4)),
+              0u)
         << name;
   }
 }
@@ -268,7 +279,7 @@ TEST(KdTree, StatisticsDescribeABinaryTree) {
     const bool copies = s.extra.at("leaf_copies").get<bool>();
     EXPECT_EQ(copies, s.references <= 3 * s.primitives) << name;
     EXPECT_EQ(s.bytes, stored * 8 + s.references * (4 + (copies ? sizeof(Triangle) : 0))) << name;
-    EXPECT_LE(s.max_depth, uint32_t(auto_kd_depth(3000)));
+    EXPECT_LE(s.max_depth, uint32_t(auto_depth_limit(3000)));
   }
   EXPECT_LE(built("kdtree-median", mesh, {{"max_depth", "5"}})->stats().max_depth, 5u);
 }
@@ -279,8 +290,10 @@ TEST(KdTree, MedianStraddleLimitBoundsTheReferences) {
   const uint64_t loose = built("kdtree-median", mesh, {{"straddle_limit", "1"}})->stats().references;
   EXPECT_LT(tight, loose);
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
-  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"straddle_limit", "1.5"}})), ParamError);
-  EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"straddle_limit", "0.5"}})), ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"straddle_limit", "1.5"}})),
+               ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"straddle_limit", "0.5"}})),
+               ParamError);
 }
 
 TEST(KdTree, SahTreeIsCheaperThanMedianTree) {
@@ -318,9 +331,12 @@ TEST(KdTree, SameTreeForOneAndTwoThreads) {
 TEST(KdTree, RejectsUnknownAndOutOfRangeParameters) {
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(random_soup(10, 1)));
   EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"leaf_size", "4"}})), ParamError);
-  EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"traversal_cost", "-1"}})), ParamError);
-  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"axis", "diagonal"}})), ParamError);
-  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"leaf_size", "0"}})), ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-sah", prims, testing::make_params({{"traversal_cost", "-1"}})),
+               ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"axis", "diagonal"}})),
+               ParamError);
+  EXPECT_THROW(make_accelerator("kdtree-median", prims, testing::make_params({{"leaf_size", "0"}})),
+               ParamError);
   auto ok = make_accelerator("kdtree-sah", prims, testing::make_params({{"intersection_cost", "3"}}));
   EXPECT_EQ(ok->config().at("intersection_cost"), 3.0);
   EXPECT_TRUE(ok->config().contains("traversal_cost"));

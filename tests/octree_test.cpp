@@ -1,11 +1,11 @@
 // Octree: child boxes, traversal against brute on geometry and rays lying in the mid-planes, depth and
 // leaf-size limits, statistics and thread-count independence.
 #include "accel/octree/octree.h"
-#include "structure_test_helpers.h"
-
-#include <tbb/global_control.h>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -96,7 +96,8 @@ TEST(Octree, MatchesBruteOnAdversarialMeshesAndInstances) {
   const Mesh mesh = adversarial_mesh(7);
   EXPECT_EQ(count_differences("octree", mesh, adversarial_rays(mesh, 3000, 5), {{"leaf_size", "2"}}), 0u);
   auto inst = testing::make_instances(random_soup(200, 2), "octree", 7);
-  EXPECT_EQ(testing::count_instance_differences("octree", inst, adversarial_rays(random_soup(50, 1), 2000, 6)), 0u);
+  EXPECT_EQ(
+      testing::count_instance_differences("octree", inst, adversarial_rays(random_soup(50, 1), 2000, 6)), 0u);
 }
 
 TEST(Octree, RespectsDepthAndLeafSize) {
@@ -105,7 +106,7 @@ TEST(Octree, RespectsDepthAndLeafSize) {
     const auto accel = built(mesh, {{"max_depth", std::to_string(depth)}, {"leaf_size", "4"}});
     const BuildStats& s = accel->stats();
     EXPECT_LE(s.max_depth, uint32_t(depth));
-    EXPECT_EQ((s.nodes - 1) % 8, 0u);                 // every interior node has eight children
+    EXPECT_EQ((s.nodes - 1) % 8, 0u);  // every interior node has eight children
     EXPECT_EQ(s.leaves, s.nodes - (s.nodes - 1) / 8);
     EXPECT_GE(s.references, 5000u);
   }

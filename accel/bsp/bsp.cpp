@@ -4,7 +4,7 @@
 
 namespace ab {
 namespace {
-const Registrar kRegisterBsp{legacy_structure_info<BspTree>(
+const Registrar kRegisterBsp{structure_info<BspTree>(
     "bsp", "BSP tree, arbitrary planes (13 directions + triangles' own planes), SAH over the cell", 35)};
 }  // namespace
 }  // namespace ab

@@ -3,35 +3,41 @@
 // tracing"): planes from a fixed set of 13 directions (the 3 axes, the 6 face diagonals and the 4 cube
 // diagonals), positioned at bin boundaries of the primitives' extents along each direction, plus the
 // supporting planes of a few of the node's own triangles (the autopartition). A plane is scored by the
-// SAH over the node's convex cell (bsp_cell.h). cut_box gives the bounding box of a box cut by a plane.
+// SAH over the node's convex cell (cell.h). cut_box gives the bounding box of a box cut by a plane.
 #pragma once
-
-#include "accel/core/aabb.h"
-#include "accel/core/instances.h"
-#include "accel/core/primitives.h"
 
 #include <array>
 #include <cmath>
 #include <vector>
 
+#include "accel/core/aabb.h"
+#include "accel/core/instances.h"
+#include "accel/core/primitives.h"
+
 namespace ab {
 
 /// A plane dot(n, x) = d with a unit normal; "below" is dot(n, x) < d.
 struct BspPlane {
-  vec3 n{1.0f, 0.0f, 0.0f};
-  float d = 0.0f;
+  vec3 n{1.0f, 0.0f, 0.0f};  ///< unit normal
+  float d = 0.0f;            ///< offset along n
 
   /// Signed distance of p (positive above).
   float distance(const vec3& p) const { return glm::dot(n, p) - d; }
 };
 static_assert(sizeof(BspPlane) == 16);
 
+/// True when the plane's normal is not one of the three axes.
+inline bool is_oblique(const BspPlane& p) {
+  return !(p.n.x == 1.0f || p.n.y == 1.0f || p.n.z == 1.0f);
+}
+
 /// The 13 fixed directions (unit length).
 inline const std::array<vec3, 13>& bsp_directions() {
   static const std::array<vec3, 13> dirs = [] {
-    const std::array<vec3, 13> raw{vec3(1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1),  vec3(1, 1, 0),  vec3(1, -1, 0),
-                                   vec3(1, 0, 1), vec3(1, 0, -1), vec3(0, 1, 1), vec3(0, 1, -1), vec3(1, 1, 1),
-                                   vec3(1, 1, -1), vec3(1, -1, 1), vec3(-1, 1, 1)};
+    const std::array<vec3, 13> raw{vec3(1, 0, 0),  vec3(0, 1, 0), vec3(0, 0, 1),  vec3(1, 1, 0),
+                                   vec3(1, -1, 0), vec3(1, 0, 1), vec3(1, 0, -1), vec3(0, 1, 1),
+                                   vec3(0, 1, -1), vec3(1, 1, 1), vec3(1, 1, -1), vec3(1, -1, 1),
+                                   vec3(-1, 1, 1)};
     std::array<vec3, 13> out;
     for (size_t i = 0; i < raw.size(); ++i) out[i] = glm::normalize(raw[i]);
     return out;
@@ -61,7 +67,8 @@ inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec
 inline int support_points(const InstancePrims& p, size_t i, const AABB& box, vec3* out) {
   const AABB b = AABB::intersection(p.bounds(i), box);
   if (b.empty()) return 0;
-  for (int c = 0; c < 8; ++c) out[c] = vec3((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z);
+  for (int c = 0; c < 8; ++c)
+    out[c] = vec3((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z);
   return 8;
 }
 
@@ -76,7 +83,9 @@ inline bool supporting_plane(const TrianglePrims& p, size_t i, BspPlane& plane) 
   return std::isfinite(plane.d);
 }
 /// Instances offer no supporting plane (their boxes are classified by corners only).
-inline bool supporting_plane(const InstancePrims&, size_t, BspPlane&) { return false; }
+inline bool supporting_plane(const InstancePrims&, size_t, BspPlane&) {
+  return false;
+}
 
 /// Bounding box of the part of box b with dot(n, x) <= d (below) or >= d (above): the corners on that side
 /// and the points where the plane cuts the twelve edges. Empty when that part is empty.

@@ -5,12 +5,12 @@
 // from the closed-surface identity: the outward vector areas of a closed polyhedron sum to zero.
 #pragma once
 
-#include "accel/bsp/candidates.h"
-
 #include <algorithm>
 #include <cmath>
 #include <span>
 #include <vector>
+
+#include "accel/bsp/candidates.h"
 
 namespace ab {
 
@@ -24,7 +24,8 @@ class ConvexCell {
     auto corner = [&](int k) {
       return vec3((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
     };
-    const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                             {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
     for (const auto& q : quads) c.faces_.push_back({corner(q[0]), corner(q[1]), corner(q[2]), corner(q[3])});
     return c;
   }
@@ -109,8 +110,10 @@ class ConvexCell {
     vec3 first{0.0f}, last{0.0f}, sum{0.0f};
     int n = 0;
     void add(const vec3& v) {
-      if (n++ == 0) first = v;
-      else sum += glm::cross(last, v);
+      if (n++ == 0)
+        first = v;
+      else
+        sum += glm::cross(last, v);
       last = v;
     }
     vec3 done() const { return n >= 3 ? 0.5f * (sum + glm::cross(last, first)) : vec3(0.0f); }
@@ -142,7 +145,8 @@ class ConvexCell {
     vec3 c(0.0f);
     for (const vec3& v : pts) c += v;
     c /= float(pts.size());
-    const vec3 u = glm::normalize(std::fabs(n.x) < 0.9f ? glm::cross(n, vec3(1, 0, 0)) : glm::cross(n, vec3(0, 1, 0)));
+    const vec3 u =
+        glm::normalize(std::fabs(n.x) < 0.9f ? glm::cross(n, vec3(1, 0, 0)) : glm::cross(n, vec3(0, 1, 0)));
     const vec3 w = glm::cross(n, u);
     // A pseudo-angle (monotonic in the angle, no atan2): position on the unit diamond, 0..4.
     auto angle = [&](const vec3& p) {
@@ -156,7 +160,8 @@ class ConvexCell {
     std::vector<vec3> out;
     for (const vec3& v : pts)
       if (out.empty() || glm::length(v - out.back()) > 1e-7f * (1.0f + glm::length(v))) out.push_back(v);
-    while (out.size() > 1 && glm::length(out.front() - out.back()) <= 1e-7f * (1.0f + glm::length(out.back())))
+    while (out.size() > 1 &&
+           glm::length(out.front() - out.back()) <= 1e-7f * (1.0f + glm::length(out.back())))
       out.pop_back();
     return out;
   }
@@ -222,7 +227,8 @@ class CellSurface {
       }
     }
     for (size_t k = 0; k < d.size(); ++k) {
-      if (!(d[k] > lowest + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as ConvexCell::part)
+      if (!(d[k] >
+            lowest + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as ConvexCell::part)
         below[k] = 0.0f;
         above[k] = total_;
       } else if (!(d[k] < highest - tol_)) {

@@ -1,113 +1,117 @@
-// Where a ray's parameter interval goes at a split plane: the one robust front-to-back step shared by
-// the k-d trees, the octree (three mid-planes per node) and the BSP tree (arbitrary planes).
+// Where a ray's parameter interval goes at a split plane: the one robust front-to-back step of every
+// spatial tree, for the k-d trees' axis planes, the octree's mid-planes and the BSP tree's arbitrary planes.
 //
 // The classic recursive traversal (Kaplan 1985; Havran 2000, "Heuristic ray shooting algorithms", TA_B rec)
-// splits the interval [t0, t1] at t_split = (split - org) / dir into a near part and a far part. Written
-// here so that it never loses a hit to rounding: both halves are widened around t_split like the slab test
-// widens box distances (geometry.h), a ray parallel to the plane stays on its side, and a ray lying in the
-// plane (or a NaN t_split) visits both sides over the whole interval. The near side is chosen by the sign
-// of the direction (not by the origin), so negative tmin and origins behind the plane need no special case.
+// splits the interval [t0, t1] at t_split = (split - org) / dir into the part before the plane and the
+// part after it. Written here so that it never loses a hit to rounding: the crossing is widened into
+// [near, far] (relatively, as the slab test widens box distances (box_test.h), and by the tree's positional
+// margin), the side met first keeps [t0, min(t1, far)] and the second side gets [max(t0, near), t1]. A ray
+// parallel to the plane has an infinite crossing and stays on its side; a ray lying in the plane (within
+// the margin) or a NaN crossing visits both sides over the whole interval. The side met first is chosen by
+// the sign of the direction (not by the origin), so negative tmin and origins behind the plane need no
+// special case. The ray is prepared once per traversal (PlaneRay, the tight form of pbrt's
+// KdTreeAggregate: origin, reciprocal direction, first side and positional band per axis), so that an
+// axis-aligned step costs a subtraction, a multiplication and a few comparisons.
 #pragma once
-
-#include "accel/core/box_test.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "accel/core/box_test.h"
+#include "accel/core/ray.h"
+
 namespace ab {
 
-/// How a ray interval [t0, t1] continues at a split plane.
+/// Where a ray crosses a plane: the widened crossing distances (near <= far, both NaN for a ray lying in
+/// the plane) and which side it meets first. Its four members are the one plane step: the first side keeps
+/// [t0, min(t1, far)] when far >= t0, the second gets [max(t0, near), t1] when near <= t1, so a NaN crossing
+/// keeps both sides over the whole interval (the comparisons are false, std::min(t1, NaN) is t1 and
+/// std::max(t0, NaN) is t0).
+struct PlaneCrossing {
+  float near, far;   ///< the crossing distance widened towards the origin and away from it
+  bool below_first;  ///< the below side (negative distance from the plane) comes first along the ray
+
+  /// True when the side met first overlaps [t0, ...].
+  [[gnu::always_inline]] bool reaches_first(float t0) const { return !(far < t0); }
+  /// True when the side met second overlaps [..., t1].
+  [[gnu::always_inline]] bool reaches_second(float t1) const { return !(near > t1); }
+  /// Exit of the first side from an interval ending at t1.
+  [[gnu::always_inline]] float first_exit(float t1) const { return std::min(t1, far); }
+  /// Entry of the second side into an interval starting at t0.
+  [[gnu::always_inline]] float second_entry(float t0) const { return std::max(t0, near); }
+};
+
+/// How a ray interval [t0, t1] continues at a plane (the octree's cells, which carry their boxes along).
 struct PlaneVisit {
-  bool first_below = true;    ///< the below (negative) side is met first along the ray
-  bool visit_first = false;   ///< the first side overlaps [t0, t1]
-  bool visit_second = false;  ///< the second side overlaps [t0, t1]
-  float first_t1 = 0.0f;      ///< exit of the first side (widened)
-  float second_t0 = 0.0f;     ///< entry of the second side (widened)
+  bool below_first;   ///< the below side is met first
+  bool visit_first;   ///< the first side overlaps [t0, t1]
+  bool visit_second;  ///< the second side overlaps [t0, t1]
+  float first_t1;     ///< exit of the first side (widened)
+  float second_t0;    ///< entry of the second side (widened)
 };
 
-/// Splits [t0, t1] at a plane given the signed distance of the origin from it (`org_dist`, negative on
-/// the below side), the rate of change of that distance along the ray (`rate`, the direction's component
-/// along the normal), t_split and the half-width `widen` of the uncertain band around t_split.
-/// `in_plane_band` is how close to the plane a parallel ray counts as lying in it.
-[[gnu::always_inline]] inline PlaneVisit split_interval(float org_dist, float rate, float t_split, float widen, float in_plane_band,
-                                 float t0, float t1) {
-  PlaneVisit v;
-  if (rate == 0.0f || t_split != t_split) {
-    v.first_below = !(org_dist > 0.0f);
-    v.visit_first = true;
-    v.visit_second = !(std::fabs(org_dist) > in_plane_band);
-    v.first_t1 = t1;
-    v.second_t0 = t0;
-    return v;
-  }
-  v.first_below = rate > 0.0f;
-  v.first_t1 = std::min(t1, t_split + widen);
-  v.second_t0 = std::max(t0, t_split - widen);
-  v.visit_first = t0 <= v.first_t1;
-  v.visit_second = v.second_t0 <= t1;
-  return v;
+/// The plane step of crossing x applied to [t0, t1], all at once.
+[[gnu::always_inline]] inline PlaneVisit split_interval(const PlaneCrossing& x, float t0, float t1) {
+  return {x.below_first, x.reaches_first(t0), x.reaches_second(t1), x.first_exit(t1), x.second_entry(t0)};
 }
 
-/// A ray's origin, direction and reciprocal direction as plain arrays (indexing a glm vector by a
-/// run-time axis goes through a switch).
-struct RayAxes {
-  float org[3], dir[3], inv[3];
-
-  /// From ray r.
-  explicit RayAxes(const Ray& r)
-      : org{r.org.x, r.org.y, r.org.z},
-        dir{r.dir.x, r.dir.y, r.dir.z},
-        inv{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z} {}
-};
-
-/// The axis-aligned case (k-d trees, octree): plane coordinate `split` on an axis where the ray has
-/// origin `org`, direction `dir` and reciprocal `inv`. The band is relative (kBoxEps), as in slab_test.
-[[gnu::always_inline]] inline PlaneVisit split_at_axis_plane(float org, float dir, float inv, float split, float t0, float t1) {
-  const float t_split = (split - org) * inv;
-  return split_interval(org - split, dir, t_split, std::fabs(t_split) * kBoxEps, 0.0f, t0, t1);
-}
-
-/// Where a ray crosses an axis-aligned plane: the widened crossing distances (near <= far, both NaN for a
-/// ray lying in the plane) and which side it meets first.
-struct AxisCrossing {
-  float near, far;   ///< widen_near(t_split), widen_far(t_split)
-  bool below_first;  ///< the below side comes first (direction's sign bit clear)
-};
-
-/// A ray prepared for many axis-aligned plane steps (the k-d tree's inner loop, after pbrt's
-/// KdTreeAggregate): origin, reciprocal direction, the side met first and a positional band, per axis.
-/// The crossing is widened relatively (kBoxEps, as slab_test) and by `margin` in position (margin / |dir|
-/// in t): the kernel may accept a hit a few ulps of the coordinates outside a triangle that touches the
-/// plane and was placed on one side only, and near t = 0 a relative widening is no widening at all. The
-/// near side comes from the sign bit of the direction. A zero component gives t_split = +-inf (the ray
-/// stays on its side) unless the origin lies within the margin of the plane: then both sides are visited
-/// over the whole interval (NaN crossings: std::max(t0, NaN) is t0 and std::min(t1, NaN) is t1).
-struct AxisRay {
-  float org[3], inv[3], band[3];
-  bool below_first[3], parallel[3];
-  float margin;
-
+/// A ray prepared for many plane steps: per axis its origin, direction, reciprocal direction, the side met
+/// first and the positional band, and the tree's positional margin. The margin is the tree's insertion
+/// margin: the kernel may accept a hit a few ulps of the coordinates outside a triangle that touches the
+/// plane and was placed on one side only, and near t = 0 a relative widening is no widening at all.
+class PlaneRay {
+ public:
   /// From ray r and the positional margin of the tree.
-  AxisRay(const Ray& r, float margin_)
-      : org{r.org.x, r.org.y, r.org.z},
-        inv{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z},
-        below_first{!std::signbit(r.dir.x), !std::signbit(r.dir.y), !std::signbit(r.dir.z)},
-        margin(margin_) {
+  PlaneRay(const Ray& r, float margin)
+      : org_{r.org.x, r.org.y, r.org.z},
+        dir_{r.dir.x, r.dir.y, r.dir.z},
+        inv_{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z},
+        below_first_{!std::signbit(r.dir.x), !std::signbit(r.dir.y), !std::signbit(r.dir.z)},
+        margin_(margin) {
     for (int a = 0; a < 3; ++a) {
-      parallel[a] = !(std::fabs(inv[a]) < kInf);
-      band[a] = parallel[a] ? 0.0f : margin * std::fabs(inv[a]);
+      parallel_[a] = !(std::fabs(inv_[a]) < kInf);
+      band_[a] = parallel_[a] ? 0.0f : margin * std::fabs(inv_[a]);
     }
   }
 
-  /// The crossing of plane coordinate `split` on axis a.
-  [[gnu::always_inline]] AxisCrossing cross(int a, float split) const {
-    const float t = (split - org[a]) * inv[a];
-    if (parallel[a]) [[unlikely]] {
-      if (std::fabs(split - org[a]) <= margin) return {std::nanf(""), std::nanf(""), below_first[a]};
-      return {t, t, below_first[a]};
+  /// The crossing of the axis-aligned plane at coordinate `split` on axis a (k-d trees, octree): widened
+  /// relatively (kBoxEps, as slab_test) and by margin / |dir| in t. A zero component gives t = +-inf (the
+  /// ray stays on its side) unless the origin lies within the margin of the plane: then NaN (both sides).
+  [[gnu::always_inline]] PlaneCrossing cross(int a, float split) const {
+    const float t = (split - org_[a]) * inv_[a];
+    if (parallel_[a]) [[unlikely]] {
+      if (std::fabs(split - org_[a]) <= margin_) return {std::nanf(""), std::nanf(""), below_first_[a]};
+      return {t, t, below_first_[a]};
     }
-    return {widen_near(t) - band[a], widen_far(t) + band[a], below_first[a]};
+    return {widen_near(t) - band_[a], widen_far(t) + band_[a], below_first_[a]};
   }
+
+  /// The crossing of the plane dot(n, x) = d (BSP tree; n of unit length): t_split = -(n.o - d) / (n.dir),
+  /// widened by a band that covers the margin and the rounding of n.o - d (relative to |d| and |n|.|o|),
+  /// divided by |n.dir| into t, plus the relative kBoxEps. A ray parallel to the plane stays on its side
+  /// unless its origin lies within that band (then NaN: both sides).
+  [[gnu::always_inline]] PlaneCrossing cross(const vec3& n, float d) const {
+    const float org_dist = dot(n, org_) - d;
+    const float rate = dot(n, dir_);
+    const float band = margin_ + (std::fabs(d) + dot(glm::abs(n), abs_org())) * 0x1p-20f;
+    const float t_split = -org_dist / rate;
+    if (rate == 0.0f) [[unlikely]] {
+      if (!(std::fabs(org_dist) > band)) return {std::nanf(""), std::nanf(""), !std::signbit(rate)};
+      return {t_split, t_split, !std::signbit(rate)};
+    }
+    const float widen = band / std::fabs(rate) + std::fabs(t_split) * kBoxEps;
+    return {t_split - widen, t_split + widen, rate > 0.0f};
+  }
+
+ private:
+  /// glm::dot's order of operations, on an array: (x + y) + z.
+  static float dot(const vec3& n, const float* v) { return n.x * v[0] + n.y * v[1] + n.z * v[2]; }
+  static float dot(const vec3& n, const vec3& v) { return n.x * v.x + n.y * v.y + n.z * v.z; }
+  vec3 abs_org() const { return {std::fabs(org_[0]), std::fabs(org_[1]), std::fabs(org_[2])}; }
+
+  float org_[3], dir_[3], inv_[3], band_[3];
+  bool below_first_[3], parallel_[3];
+  float margin_;
 };
 
 }  // namespace ab

@@ -1,20 +1,22 @@
 #include "accel/grid/grid.h"
 
-#include "accel/core/clip.h"
-#include "accel/core/registry.h"
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "accel/common/conservative_insertion.h"
+#include "accel/common/tree_stats.h"
+#include "accel/core/clip.h"
+#include "accel/core/registry.h"
+
 namespace ab {
 
-GridConfig read_grid_config(Params& params) {
+GridConfig GridConfig::read(Params& params) {
   GridConfig c;
-  c.lambda = params.get_float("lambda", c.lambda, 0.01, 100.0);
-  c.max_cells = uint64_t(params.get_int("max_cells", (long long)c.max_cells, 1, 1ll << 31));
+  params.read("lambda", c.lambda, 0.01, 100.0);
+  params.read("max_cells", c.max_cells, 1, double(1ll << 31));
   return c;
 }
 
@@ -27,7 +29,8 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
   if (bounds.empty()) return g;
   g.box = bounds;
   const vec3 e = bounds.extent();
-  const double budget = std::min(std::pow(config.lambda, 3.0) * double(std::max<size_t>(n, 1)), double(config.max_cells));
+  const double budget =
+      std::min(std::pow(config.lambda, 3.0) * double(std::max<size_t>(n, 1)), double(config.max_cells));
   bool active[3] = {e.x > 0.0f, e.y > 0.0f, e.z > 0.0f};
   double res[3] = {1.0, 1.0, 1.0};
   for (int round = 0; round < 3; ++round) {
@@ -58,10 +61,7 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
 }
 
 float insertion_margin(const GridLayout& g) {
-  const vec3 e = g.box.extent();
-  float scale = std::max({e.x, e.y, e.z});
-  for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(g.box.lo[a]), std::fabs(g.box.hi[a])});
-  return scale * 0x1p-17f;
+  return 2.0f * insertion_margin(g.box);
 }
 
 namespace {
@@ -123,8 +123,10 @@ void clip_to_slab(const SlabPolygon& in, int axis, float lo, float hi, SlabPolyg
   if (min_c > hi || max_c < lo) {
     out.n = 0;
   } else if (max_c <= hi) {  // only the lower plane cuts, if any
-    if (min_c >= lo) out = in;
-    else clip(in, lo, -1.0f, out);
+    if (min_c >= lo)
+      out = in;
+    else
+      clip(in, lo, -1.0f, out);
   } else if (min_c >= lo) {  // only the upper plane cuts
     clip(in, hi, 1.0f, out);
   } else {
@@ -157,24 +159,31 @@ void row_x_extent(const SlabPolygon& p, float lo, float hi, float& lo_x, float& 
 // the polygon), widened again, gives the cells. The widened
 // slabs and rows contain every cell box grown by inflate_for_insertion (whose growth is at most half the
 // margin), so every cell the exact test against such a box accepts is found.
-void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, float margin, std::vector<uint64_t>& out) {
+void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, float margin,
+                       std::vector<uint64_t>& out) {
   const CellRange r(g, t.bounds(), margin);
   if (r.is_line()) return append_range(g, r, id, out);  // connected: it meets every cell of a line
   SlabPolygon tri;
   tri.v[0] = t.v0, tri.v[1] = t.v1, tri.v[2] = t.v2, tri.n = 3;
   SlabPolygon slab;
   for (int z = r.lo[2]; z <= r.hi[2]; ++z) {
-    if (r.lo[2] == r.hi[2]) slab = tri;
-    else clip_to_slab(tri, 2, g.plane(2, z) - margin, g.plane(2, z + 1) + margin, slab);
+    if (r.lo[2] == r.hi[2])
+      slab = tri;
+    else
+      clip_to_slab(tri, 2, g.plane(2, z) - margin, g.plane(2, z + 1) + margin, slab);
     if (slab.n == 0) continue;
     float lo, hi;
     polygon_extent(slab, 1, lo, hi);
-    const int y0 = std::max(r.lo[1], g.cell_of(1, lo - margin)), y1 = std::min(r.hi[1], g.cell_of(1, hi + margin));
+    const int y0 = std::max(r.lo[1], g.cell_of(1, lo - margin)),
+              y1 = std::min(r.hi[1], g.cell_of(1, hi + margin));
     for (int y = y0; y <= y1; ++y) {
-      if (y0 == y1) polygon_extent(slab, 0, lo, hi);
-      else row_x_extent(slab, g.plane(1, y) - margin, g.plane(1, y + 1) + margin, lo, hi);
+      if (y0 == y1)
+        polygon_extent(slab, 0, lo, hi);
+      else
+        row_x_extent(slab, g.plane(1, y) - margin, g.plane(1, y + 1) + margin, lo, hi);
       if (!(lo <= hi)) continue;
-      const int x0 = std::max(r.lo[0], g.cell_of(0, lo - margin)), x1 = std::min(r.hi[0], g.cell_of(0, hi + margin));
+      const int x0 = std::max(r.lo[0], g.cell_of(0, lo - margin)),
+                x1 = std::min(r.hi[0], g.cell_of(0, hi + margin));
       for (int x = x0; x <= x1; ++x) out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
     }
   }
@@ -193,13 +202,16 @@ CellInserter box_test_inserter(const GridLayout& g, std::span<const AABB> prim_b
     for (int z = r.lo[2]; z <= r.hi[2]; ++z)
       for (int y = r.lo[1]; y <= r.hi[1]; ++y)
         for (int x = r.lo[0]; x <= r.hi[0]; ++x)
-          if (overlaps(id, inflate_for_insertion(g.cell_box(x, y, z)))) out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
+          if (overlaps(id, inflate_for_insertion(g.cell_box(x, y, z))))
+            out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
   };
 }
 
 CellInserter triangle_inserter(const GridLayout& g, std::span<const Triangle> triangles) {
   const float margin = insertion_margin(g);
-  return [&g, triangles, margin](uint32_t id, std::vector<uint64_t>& out) { voxelize_triangle(g, triangles[id], id, margin, out); };
+  return [&g, triangles, margin](uint32_t id, std::vector<uint64_t>& out) {
+    voxelize_triangle(g, triangles[id], id, margin, out);
+  };
 }
 
 namespace {
@@ -299,31 +311,52 @@ GridWalk::GridWalk(const GridLayout& g, const Ray& ray, const RayBoxData& rd, fl
   }
 }
 
-BuildStats grid_stats(const GridLayout& g, const GridCells& cells, size_t primitives, const GridConfig& config) {
-  BuildStats s;
-  s.primitives = primitives;
-  const size_t n = g.cells();
-  s.nodes = n;
-  s.leaves = n;
-  s.references = cells.ids.size();
-  std::vector<uint64_t> histogram;
-  for (size_t c = 0; c < n; ++c) {
-    const uint32_t size = cells.offsets[c + 1] - cells.offsets[c];
-    if (size >= histogram.size()) histogram.resize(size + 1);
-    ++histogram[size];
+namespace {
+
+/// The grid as the one statistics walk sees it: the grid box is the root and every cell one of its leaves.
+/// No node has an area for the walk (box() is empty): the tree SAH prices the visits of a tree, not the
+/// steps of a 3D-DDA, so a grid reports no SAH cost.
+struct GridStatsVisitor {
+  /// The grid box (kGridBox) or a cell index.
+  using Node = uint32_t;
+  static constexpr Node kGridBox = 0xFFFFFFFFu;  ///< the root
+  const GridCells& cells;                        ///< the cells
+  uint32_t cell_count;                           ///< number of cells
+
+  /// The grid box.
+  Node root() const { return kGridBox; }
+  /// No area (see above).
+  AABB box(Node) const { return AABB{}; }
+  /// True for the cells.
+  bool is_leaf(Node n) const { return n != kGridBox; }
+  /// Primitives of a cell.
+  uint32_t count(Node n) const { return cells.offsets[n + 1] - cells.offsets[n]; }
+  /// Every cell of the grid box.
+  template <class F>
+  void children(Node, F&& f) const {
+    for (uint32_t c = 0; c < cell_count; ++c) f(c);
   }
-  for (size_t k = 0; k < histogram.size(); ++k)
-    if (histogram[k]) s.leaf_size_histogram[uint32_t(k)] = histogram[k];
-  s.empty_leaves = histogram.empty() ? 0 : histogram[0];
-  s.bytes = (cells.offsets.size() + cells.ids.size()) * sizeof(uint32_t);
-  s.extra["resolution"] = {g.res[0], g.res[1], g.res[2]};
-  s.extra["lambda"] = config.lambda;
-  s.extra["cells"] = n;
-  return s;
+};
+
+}  // namespace
+
+void gather_grid_stats(const GridLayout& g, const GridCells& cells, const GridConfig& config,
+                       BuildStats& stats) {
+  const size_t n = g.cells();
+  if (cells.offsets.size() == n + 1) walk_tree_stats(GridStatsVisitor{cells, uint32_t(n)}, stats);
+  // The grid box is the walk's root but not a node of the grid: a grid reports its cells as its nodes and
+  // leaves, all at depth 0 (as it always has).
+  stats.nodes = n;
+  stats.max_depth = 0;
+  stats.mean_leaf_depth = 0.0;
+  stats.bytes = (cells.offsets.size() + cells.ids.size()) * sizeof(uint32_t);
+  stats.extra["resolution"] = {g.res[0], g.res[1], g.res[2]};
+  stats.extra["lambda"] = config.lambda;
+  stats.extra["cells"] = n;
 }
 
 namespace {
-const Registrar kRegisterGrid{legacy_structure_info<Grid>(
+const Registrar kRegisterGrid{structure_info<Grid>(
     "grid", "uniform grid, exact insertion, 3D-DDA (Amanatides and Woo 1987) with mailboxing", 20)};
 }  // namespace
 

@@ -3,11 +3,6 @@
 // (Amanatides and Woo 1987, "A fast voxel traversal algorithm for ray tracing") with a per-ray mailbox.
 #pragma once
 
-#include "accel/core/box_test.h"
-#include "accel/core/accelerator.h"
-#include "accel/core/params.h"
-#include "accel/core/primitives.h"
-
 #include <tbb/parallel_for.h>
 
 #include <array>
@@ -19,23 +14,28 @@
 #include <type_traits>
 #include <vector>
 
+#include "accel/core/accelerator.h"
+#include "accel/core/box_test.h"
+#include "accel/core/params.h"
+#include "accel/core/primitives.h"
+
 namespace ab {
 
-/// Grid settings.
+/// Configuration of the grid.
 struct GridConfig {
-  double lambda = 1.0;              ///< density: about lambda * cbrt(N) cells per axis for a cube (lambda^3 N cells)
+  double lambda = 1.0;  ///< density: about lambda * cbrt(N) cells per axis for a cube (lambda^3 N cells)
   uint64_t max_cells = 1ull << 24;  ///< cap on the number of cells
-};
 
-/// Reads a GridConfig from params (lambda, max_cells).
-GridConfig read_grid_config(Params& params);
+  /// Reads every field from params.
+  static GridConfig read(Params& params);
+};
 
 /// The geometry of a grid: its box, resolution and cell size. Cell (x, y, z) spans planes x..x+1 etc.
 struct GridLayout {
-  AABB box;
-  std::array<int, 3> res{0, 0, 0};
-  vec3 cell_size{0.0f};
-  vec3 inv_cell_size{0.0f};  ///< 0 on a flat axis (which always has one cell)
+  AABB box;                         ///< the grid box
+  std::array<int, 3> res{0, 0, 0};  ///< cells per axis
+  vec3 cell_size{0.0f};             ///< extent of a cell per axis
+  vec3 inv_cell_size{0.0f};         ///< 0 on a flat axis (which always has one cell)
 
   /// Number of cells.
   size_t cells() const { return size_t(res[0]) * size_t(res[1]) * size_t(res[2]); }
@@ -48,7 +48,9 @@ struct GridLayout {
     return x >= float(res[a] - 1) ? res[a] - 1 : int(x);
   }
   /// Linear index of cell (x, y, z).
-  size_t index(int x, int y, int z) const { return (size_t(z) * size_t(res[1]) + size_t(y)) * size_t(res[0]) + size_t(x); }
+  size_t index(int x, int y, int z) const {
+    return (size_t(z) * size_t(res[1]) + size_t(y)) * size_t(res[0]) + size_t(x);
+  }
   /// Box of cell (x, y, z).
   AABB cell_box(int x, int y, int z) const {
     return {{plane(0, x), plane(1, y), plane(2, z)}, {plane(0, x + 1), plane(1, y + 1), plane(2, z + 1)}};
@@ -62,8 +64,8 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
 
 /// Cells in compressed rows: the ids of cell c are ids[offsets[c] .. offsets[c+1]), ascending.
 struct GridCells {
-  std::vector<uint32_t> offsets;
-  std::vector<uint32_t> ids;
+  std::vector<uint32_t> offsets;  ///< cells + 1 row starts
+  std::vector<uint32_t> ids;      ///< the cells' primitive ids, cell after cell
 };
 
 /// Appends to `out` the cells primitive `id` goes into, each as (cell index << 32) | id, in ascending
@@ -75,7 +77,8 @@ using OverlapTest = std::function<bool(uint32_t, const AABB&)>;
 
 /// Generic insertion (any primitive set): every cell of the primitive's margin-widened bounds whose
 /// inflated box (inflate_for_insertion) the primitive overlaps according to `overlaps`.
-CellInserter box_test_inserter(const GridLayout& layout, std::span<const AABB> prim_bounds, OverlapTest overlaps);
+CellInserter box_test_inserter(const GridLayout& layout, std::span<const AABB> prim_bounds,
+                               OverlapTest overlaps);
 
 /// Triangle insertion by voxelization: the triangle is clipped to each slab of cells along z, the slab
 /// polygon to each row along y, and the row polygon's x extent gives the cells. Every slab, row and extent
@@ -113,9 +116,9 @@ class Mailbox {
 /// The state of a 3D-DDA walk: the current cell and, per axis, the step and the ray parameter of the
 /// next plane crossing (computed directly from the plane position each time, never accumulated).
 struct GridWalk {
-  int cell[3];
-  int step[3];
-  float t_next[3];
+  int cell[3];      ///< current cell coordinates
+  int step[3];      ///< +1, -1 or 0 per axis
+  float t_next[3];  ///< parameter of the next plane crossing per axis
 
   /// Starts the walk at parameter t0 (the ray's entry into the grid box).
   GridWalk(const GridLayout& g, const Ray& ray, const RayBoxData& rd, float t0);
@@ -123,7 +126,8 @@ struct GridWalk {
   float exit() const { return std::min(t_next[0], std::min(t_next[1], t_next[2])); }
   /// Moves to the next cell; false when the ray leaves the grid.
   bool advance(const GridLayout& g, const RayBoxData& rd) {
-    const int a = t_next[0] <= t_next[1] ? (t_next[0] <= t_next[2] ? 0 : 2) : (t_next[1] <= t_next[2] ? 1 : 2);
+    const int a =
+        t_next[0] <= t_next[1] ? (t_next[0] <= t_next[2] ? 0 : 2) : (t_next[1] <= t_next[2] ? 1 : 2);
     if (step[a] == 0) return false;
     cell[a] += step[a];
     if (cell[a] < 0 || cell[a] >= g.res[a]) return false;
@@ -132,16 +136,24 @@ struct GridWalk {
   }
 };
 
+/// Statistics of a built grid for the one statistics walk (tree_stats.h: the cells as the leaves of the
+/// grid box), with the bytes and the resolution.
+void gather_grid_stats(const GridLayout& layout, const GridCells& cells, const GridConfig& config,
+                       BuildStats& stats);
+
 /// A uniform grid over primitive set P.
 template <class P>
 class Grid final : public AcceleratorBase<Grid<P>> {
  public:
-  /// Reads the Config from params; the build is separate (build()).
-  Grid(std::shared_ptr<const P> prims, Params& params)
-      : prims_(std::move(prims)), config_(read_grid_config(params)), effective_(params.effective()) {}
+  /// The primitive set.
+  using Prims = P;
+  /// The grid's configuration.
+  using Config = GridConfig;
 
-  std::string name() const override { return "grid"; }
-  nlohmann::json config() const override { return effective_; }
+  /// Over prims with config; the build is separate (build()).
+  Grid(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {}
+
+  /// Bounds of the primitives.
   AABB bounds() const override { return prims_->bounds(); }
   /// The grid's geometry (for tests).
   const GridLayout& layout() const { return layout_; }
@@ -160,7 +172,8 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     GridWalk walk(layout_, ray, rd, t0);
     Mailbox mailbox;
     for (;;) {
-      visit_cell<kCount>(walk, mailbox, c, [&](uint32_t id) { prims_->template intersect<kCount>(id, ray, best, inst, c); });
+      visit_cell<kCount>(walk, mailbox, c,
+                         [&](uint32_t id) { prims_->template intersect<kCount>(id, ray, best, inst, c); });
       const float t_exit = widen_near(walk.exit());
       if (best.t < t_exit || t_exit > t1 || !walk.advance(layout_, rd)) return;
     }
@@ -177,9 +190,8 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     Mailbox mailbox;
     for (;;) {
       bool hit = false;
-      visit_cell<kCount>(walk, mailbox, c, [&](uint32_t id) {
-        return hit = prims_->template occluded<kCount>(id, ray, c);
-      });
+      visit_cell<kCount>(walk, mailbox, c,
+                         [&](uint32_t id) { return hit = prims_->template occluded<kCount>(id, ray, c); });
       if (hit) return true;
       if (widen_near(walk.exit()) > t1 || !walk.advance(layout_, rd)) return false;
     }
@@ -197,11 +209,16 @@ class Grid final : public AcceleratorBase<Grid<P>> {
         for (size_t i = r.begin(); i < r.end(); ++i) boxes[i] = prims_->bounds(i);
       });
       const P& prims = *prims_;
-      cells_ = build_grid_cells(layout_, n, box_test_inserter(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
-                                  return prims.overlaps(i, b);
-                                }));
+      cells_ =
+          build_grid_cells(layout_, n, box_test_inserter(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
+                             return prims.overlaps(i, b);
+                           }));
     }
-    fill_stats();
+  }
+
+  void gather_stats(BuildStats& stats) const override {
+    stats.primitives = prims_->size();
+    gather_grid_stats(layout_, cells_, config_, stats);
   }
 
  private:
@@ -229,21 +246,10 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     }
   }
 
-  void fill_stats();
-
   std::shared_ptr<const P> prims_;
   GridConfig config_;
-  nlohmann::json effective_;
   GridLayout layout_;
   GridCells cells_;
 };
-
-/// Statistics of a built grid (cells, histogram, references, bytes, resolution).
-BuildStats grid_stats(const GridLayout& layout, const GridCells& cells, size_t primitives, const GridConfig& config);
-
-template <class P>
-void Grid<P>::fill_stats() {
-  this->stats_ = grid_stats(layout_, cells_, prims_->size(), config_);
-}
 
 }  // namespace ab

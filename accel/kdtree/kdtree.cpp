@@ -4,9 +4,9 @@
 
 namespace ab {
 namespace {
-const Registrar kRegisterKdMedian{legacy_structure_info<KdTreeMedian>(
+const Registrar kRegisterKdMedian{structure_info<KdTreeMedian>(
     "kdtree-median", "k-d tree, median splits along the longest axis, conservative insertion", 30)};
-const Registrar kRegisterKdSah{legacy_structure_info<KdTreeSah>(
+const Registrar kRegisterKdSah{structure_info<KdTreeSah>(
     "kdtree-sah", "k-d tree, O(N log N) SAH build with perfect splits (Wald and Havran 2006)", 31)};
 }  // namespace
 }  // namespace ab

@@ -6,23 +6,16 @@
 // touches the plane or comes within the insertion margin of it goes to both children.
 #pragma once
 
-#include "accel/common/spatial_tree.h"
-
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <vector>
 
-namespace ab {
+#include "accel/common/conservative_insertion.h"
+#include "accel/kdtree/config.h"
+#include "accel/kdtree/node.h"
 
-/// Settings of the median k-d builder.
-struct KdMedianSettings {
-  size_t leaf_size = 4;        ///< a node with at most this many primitives is a leaf
-  int max_depth = 0;           ///< resolved depth limit (> 0)
-  bool cycle_axes = false;     ///< false: longest axis of the node box; true: x, y, z in turn
-  double straddle_limit = 0.75; ///< a node whose split would put more than this share of it on both sides is a leaf
-  size_t parallel_min = 16384; ///< nodes at least this large build their children in parallel
-};
+namespace ab {
 
 /// Builds median-split k-d trees over a primitive set P.
 template <class P>
@@ -30,12 +23,13 @@ class KdMedianBuilder {
  public:
   /// A primitive in a node: its id and its bounds clipped to the node box.
   struct Ref {
-    uint32_t id;
-    AABB cb;
+    uint32_t id;  ///< primitive id
+    AABB cb;      ///< its bounds clipped to the node box
   };
 
-  /// Builder over prims with settings s.
-  KdMedianBuilder(const P& prims, const KdMedianSettings& s) : prims_(prims), s_(s) {}
+  /// Builder over prims with the tree's configuration and its resolved depth limit (> 0).
+  KdMedianBuilder(const P& prims, const KdMedianConfig& config, int depth_limit)
+      : prims_(prims), config_(config), depth_limit_(depth_limit) {}
 
   /// Builds the tree over the primitives ids (finite bounds) inside box into out.
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
@@ -47,9 +41,9 @@ class KdMedianBuilder {
  private:
   void build_node(std::vector<Ref>&& refs, const AABB& box, int depth, KdBuffer& out) const {
     const size_t n = refs.size();
-    int axis = s_.cycle_axes ? depth % 3 : box.longest_axis();
+    int axis = config_.axis == KdAxisRule::kCycle ? depth % 3 : box.longest_axis();
     float split = 0.0f;
-    if (n <= s_.leaf_size || depth >= s_.max_depth || !median_plane(refs, box, axis, split)) {
+    if (n <= config_.leaf_size || depth >= depth_limit_ || !median_plane(refs, box, axis, split)) {
       make_leaf(refs, out);
       return;
     }
@@ -58,14 +52,14 @@ class KdMedianBuilder {
     lbox.hi[axis] = split;
     rbox.lo[axis] = split;
     partition(refs, axis, split, insertion_margin(box), lbox, rbox, left, right);
-    if (double(left.size() + right.size()) > double(n) * (1.0 + s_.straddle_limit)) {  // splitting no longer pays
+    if (double(left.size() + right.size()) > double(n) * (1.0 + config_.straddle_limit)) {  // no longer pays
       make_leaf(refs, out);
       return;
     }
     std::vector<Ref>().swap(refs);
     const size_t self = out.nodes.size();
     out.nodes.push_back(KdNode::leaf(0, 0));
-    if (n >= s_.parallel_min) {
+    if (n >= kParallelMin) {
       KdBuffer lb, rb;
       tbb::parallel_invoke([&] { build_node(std::move(left), lbox, depth + 1, lb); },
                            [&] { build_node(std::move(right), rbox, depth + 1, rb); });
@@ -109,11 +103,14 @@ class KdMedianBuilder {
     std::vector<uint32_t> ids(refs.size());
     for (size_t i = 0; i < refs.size(); ++i) ids[i] = refs[i].id;
     std::sort(ids.begin(), ids.end());
-    out.add_leaf(ids);
+    out.nodes.push_back(out.make_leaf(ids));
   }
 
+  /// Nodes at least this large build their children in parallel.
+  static constexpr size_t kParallelMin = 16384;
   const P& prims_;
-  KdMedianSettings s_;
+  KdMedianConfig config_;
+  int depth_limit_;
 };
 
 }  // namespace ab

@@ -3,10 +3,10 @@
 // planar events sorted once at the root; the best plane of all three axes is found by one linear sweep,
 // and the lists are split into the children's lists in linear time (primitives on one side keep their
 // events in order; straddling ones are clipped to each child box, "perfect splits", and their few new
-// events sorted and merged). Cost model: C = lambda (Ct + Ci (P_L N_L + P_R N_R)) with lambda = 1 - bonus
-// when one side is empty; planar primitives are counted on the cheaper side; a node becomes a leaf when
-// no plane beats Ci N. The upper levels build in parallel on TBB; the tree is the same for any thread
-// count (every subtree is built deterministically and spliced in a fixed order).
+// events sorted and merged). Cost model (SahCosts, sah.h): C = lambda (Ct + Ci (P_L N_L + P_R N_R)) with
+// lambda = 1 - bonus when one side is empty; planar primitives are counted on the cheaper side; a node
+// becomes a leaf when no plane beats Ci N. The upper levels build in parallel on TBB; the tree is the same
+// for any thread count (every subtree is built deterministically and spliced in a fixed order).
 //
 // Robustness without duplicating every primitive that touches a plane: the traversal widens the two
 // halves of the ray interval around t_split (split_plane.h), so a hit on the plane itself (flat geometry
@@ -14,8 +14,6 @@
 // straddling primitives are clipped into boxes grown by the insertion margin, so clipping rounding never
 // drops a sliver.
 #pragma once
-
-#include "accel/common/spatial_tree.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -25,21 +23,17 @@
 #include <cstdint>
 #include <vector>
 
-namespace ab {
+#include "accel/common/conservative_insertion.h"
+#include "accel/common/sah.h"
+#include "accel/kdtree/config.h"
+#include "accel/kdtree/node.h"
 
-/// Settings of the SAH k-d builder.
-struct KdSahSettings {
-  float traversal_cost = 1.0f;    ///< Ct
-  float intersection_cost = 1.5f; ///< Ci
-  float empty_bonus = 0.2f;       ///< 1 - lambda for splits with an empty side
-  int max_depth = 0;              ///< resolved depth limit (> 0)
-  size_t parallel_min = 16384;    ///< nodes at least this large build their children in parallel
-};
+namespace ab {
 
 /// A sweep event: position along one axis and (primitive's index in its node << 2 | type).
 struct KdEvent {
-  float pos;
-  uint32_t key;
+  float pos;     ///< position along the axis
+  uint32_t key;  ///< local index << 2 | type
 
   /// Event types, in the order the sweep needs at one position: ends, planars, starts.
   enum Type : uint32_t { kEnd = 0, kPlanar = 1, kStart = 2 };
@@ -57,9 +51,9 @@ struct KdEvent {
 
 /// A node under construction: box, primitive ids and the sorted events of each axis.
 struct KdEventNode {
-  AABB box;
-  std::vector<uint32_t> ids;
-  std::array<std::vector<KdEvent>, 3> events;
+  AABB box;                                    ///< the node's box
+  std::vector<uint32_t> ids;                   ///< its primitives
+  std::array<std::vector<KdEvent>, 3> events;  ///< per axis, sorted
 };
 
 /// Appends the events of a primitive with clipped bounds cb as local index `local`.
@@ -76,18 +70,12 @@ inline void add_kd_events(const AABB& cb, uint32_t local, std::array<std::vector
 
 /// Result of the sweep.
 struct KdSahPlane {
-  int axis = -1;         ///< -1: no plane inside the box
-  float pos = 0.0f;
-  float cost = kInf;
-  bool planar_left = true;  ///< planar primitives at pos are counted on the left
-  uint32_t n_left = 0, n_right = 0;
+  int axis = -1;                     ///< -1: no plane inside the box
+  float pos = 0.0f;                  ///< plane position
+  float cost = kInf;                 ///< its SAH cost
+  bool planar_left = true;           ///< planar primitives at pos are counted on the left
+  uint32_t n_left = 0, n_right = 0;  ///< primitives on each side
 };
-
-/// Wald-Havran SAH cost of a plane with counts and areas (areas relative to the node's).
-inline float kd_sah_cost(const KdSahSettings& s, float pl, float pr, uint32_t nl, uint32_t nr) {
-  const float lambda = (nl == 0 || nr == 0) ? 1.0f - s.empty_bonus : 1.0f;
-  return lambda * (s.traversal_cost + s.intersection_cost * (pl * float(nl) + pr * float(nr)));
-}
 
 /// Area terms of the children of a node box along one axis, so that each plane costs a few flops.
 struct KdAxisAreas {
@@ -103,20 +91,22 @@ struct KdAxisAreas {
   }
 };
 
-/// Evaluates plane `pos` on axis a with the paper's counts, both placements of planar primitives.
-inline void evaluate_kd_plane(const KdSahSettings& s, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
+/// Evaluates plane `pos` on axis a with the paper's counts, both placements of planar primitives. The
+/// areas are relative to the node's (the probabilities P_L, P_R), so the cost model is called with a
+/// parent area of 1.
+inline void evaluate_kd_plane(const SahCosts& costs, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
                               uint32_t np, uint32_t nr, KdSahPlane& best) {
   const float pl = (ar.cap + ar.side * (pos - ar.lo)) * ar.inv_area;
   const float pr = (ar.cap + ar.side * (ar.hi - pos)) * ar.inv_area;
-  const float cl = kd_sah_cost(s, pl, pr, nl + np, nr);
-  const float cr = np ? kd_sah_cost(s, pl, pr, nl, nr + np) : cl;
+  const float cl = costs.split(1.0f, pl, nl + np, pr, nr);
+  const float cr = np ? costs.split(1.0f, pl, nl, pr, nr + np) : cl;
   const float c = std::min(cl, cr);
   if (c < best.cost) best = {a, pos, c, cl <= cr, cl <= cr ? nl + np : nl, cl <= cr ? nr : nr + np};
 }
 
 /// Finds the cheapest plane strictly inside the node box by one sweep per axis (Wald and Havran 2006,
 /// algorithm 4).
-inline KdSahPlane find_kd_sah_plane(const KdSahSettings& s, const KdEventNode& node) {
+inline KdSahPlane find_kd_sah_plane(const SahCosts& costs, const KdEventNode& node) {
   KdSahPlane best;
   if (!(node.box.area() > 0.0f)) return best;
   const uint32_t n = uint32_t(node.ids.size());
@@ -131,7 +121,7 @@ inline KdSahPlane find_kd_sah_plane(const KdSahSettings& s, const KdEventNode& n
       for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kPlanar; ++i) ++planars;
       for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kStart; ++i) ++starts;
       nr -= planars + ends;
-      if (p > node.box.lo[a] && p < node.box.hi[a]) evaluate_kd_plane(s, ar, a, p, nl, planars, nr, best);
+      if (p > node.box.lo[a] && p < node.box.hi[a]) evaluate_kd_plane(costs, ar, a, p, nl, planars, nr, best);
       nl += starts + planars;
     }
   }
@@ -142,8 +132,9 @@ inline KdSahPlane find_kd_sah_plane(const KdSahSettings& s, const KdEventNode& n
 template <class P>
 class KdSahBuilder {
  public:
-  /// Builder over prims with settings s.
-  KdSahBuilder(const P& prims, const KdSahSettings& s) : prims_(prims), s_(s) {}
+  /// Builder over prims with the tree's configuration and its resolved depth limit (> 0).
+  KdSahBuilder(const P& prims, const KdSahConfig& config, int depth_limit)
+      : prims_(prims), costs_(config.costs), depth_limit_(depth_limit) {}
 
   /// Builds the tree over the primitives `ids` (finite bounds) inside `box` into out.
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
@@ -187,21 +178,21 @@ class KdSahBuilder {
   void build_node(KdEventNode&& node, int depth, KdBuffer& out) const {
     const size_t n = node.ids.size();
     KdSahPlane plane;
-    if (n > 0 && depth < s_.max_depth) plane = find_kd_sah_plane(s_, node);
-    if (plane.axis < 0 || plane.cost >= s_.intersection_cost * float(n)) {
-      out.add_leaf(node.ids);
+    if (n > 0 && depth < depth_limit_) plane = find_kd_sah_plane(costs_, node);
+    if (plane.axis < 0 || plane.cost >= costs_.leaf(n)) {
+      out.nodes.push_back(out.make_leaf(node.ids));
       return;
     }
     const float split = plane.pos;
     KdEventNode left, right;
     partition(std::move(node), plane.axis, split, plane.planar_left, left, right);
     if (left.ids.size() == n && right.ids.size() == n) {
-      out.add_leaf(left.ids);
+      out.nodes.push_back(out.make_leaf(left.ids));
       return;
     }
     const size_t self = out.nodes.size();
     out.nodes.push_back(KdNode::leaf(0, 0));
-    if (n >= s_.parallel_min) {
+    if (n >= kParallelMin) {
       KdBuffer lb, rb;
       tbb::parallel_invoke([&] { build_node(std::move(left), depth + 1, lb); },
                            [&] { build_node(std::move(right), depth + 1, rb); });
@@ -229,9 +220,12 @@ class KdSahBuilder {
     std::vector<uint8_t> side(n, 3);
     for (const KdEvent& e : node.events[a]) {
       const uint32_t t = e.local();
-      if (e.type() == KdEvent::kEnd && e.pos <= split) side[t] = 1;
-      else if (e.type() == KdEvent::kStart && e.pos >= split) side[t] = 2;
-      else if (e.type() == KdEvent::kPlanar) side[t] = e.pos < split ? 1 : e.pos > split ? 2 : planar_left ? 1 : 2;
+      if (e.type() == KdEvent::kEnd && e.pos <= split)
+        side[t] = 1;
+      else if (e.type() == KdEvent::kStart && e.pos >= split)
+        side[t] = 2;
+      else if (e.type() == KdEvent::kPlanar)
+        side[t] = e.pos < split ? 1 : e.pos > split ? 2 : planar_left ? 1 : 2;
     }
     std::vector<uint32_t> to_left(n), to_right(n);
     for (size_t t = 0; t < n; ++t) {
@@ -261,8 +255,10 @@ class KdSahBuilder {
                            std::vector<KdEvent>& left, std::vector<KdEvent>& right) {
     for (const KdEvent& e : ev) {
       const uint32_t t = e.local();
-      if (side[t] == 1) left.push_back({e.pos, (to_left[t] << 2) | e.type()});
-      else if (side[t] == 2) right.push_back({e.pos, (to_right[t] << 2) | e.type()});
+      if (side[t] == 1)
+        left.push_back({e.pos, (to_left[t] << 2) | e.type()});
+      else if (side[t] == 2)
+        right.push_back({e.pos, (to_right[t] << 2) | e.type()});
     }
   }
 
@@ -278,13 +274,17 @@ class KdSahBuilder {
       if (extra[k].empty()) continue;
       std::sort(extra[k].begin(), extra[k].end());
       std::vector<KdEvent> merged(child.events[k].size() + extra[k].size());
-      std::merge(child.events[k].begin(), child.events[k].end(), extra[k].begin(), extra[k].end(), merged.begin());
+      std::merge(child.events[k].begin(), child.events[k].end(), extra[k].begin(), extra[k].end(),
+                 merged.begin());
       child.events[k].swap(merged);
     }
   }
 
+  /// Nodes at least this large build their children in parallel.
+  static constexpr size_t kParallelMin = 16384;
   const P& prims_;
-  KdSahSettings s_;
+  SahCosts costs_;
+  int depth_limit_;
 };
 
 }  // namespace ab

@@ -4,7 +4,7 @@
 
 namespace ab {
 namespace {
-const Registrar kRegisterOctree{legacy_structure_info<Octree>(
+const Registrar kRegisterOctree{structure_info<Octree>(
     "octree", "adaptive octree, exact triangle/box insertion, parametric front-to-back traversal", 20)};
 }  // namespace
 }  // namespace ab
