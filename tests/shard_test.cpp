@@ -4,9 +4,13 @@
 #include "harness/shard.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <numeric>
+#include <thread>
 
 #include "accel/core/error.h"
 #include "tests/shard_test_helpers.h"
@@ -223,6 +227,53 @@ TEST_F(Merge, RefusesShardsThatDoNotMakeOneRun) {
   std::string err;
   EXPECT_EQ(merge({"shard-1", "shard-2", "shard-3"}, "shard-1", err), 2);
   EXPECT_NE(err.find("is one of the shard folders"), std::string::npos) << err;
+}
+
+TEST_F(Merge, ShardStoppedBySigtermIsRefused) {
+  // A scheduler's time limit or scancel sends SIGTERM: the shard stops after its current case, keeps what it
+  // finished, exits 130 and says so in its report, which merge then refuses.
+  const std::string suite = dir_ + "/slow.json";
+  std::ofstream(suite) << R"({"repetitions": 3, "threads": [1], "min_time": 0.05,
+    "scenes": [{"generator": "soup", "triangles": [300, 301, 302, 303, 304, 305, 306, 307]}],
+    "accelerators": ["bvh-sah", "embree"], "rays": [{"kind": "incoherent", "count": 4096}]})";
+  const std::string out = dir_ + "/slow-1";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string b = test::accelbench_bin();
+    if (!::freopen("/dev/null", "w", stdout)) ::_exit(127);
+    ::execl(b.c_str(), b.c_str(), "run", suite.c_str(), "--shard", "1/2", "-o", out.c_str(), "--no-plot",
+            (char*)nullptr);
+    ::_exit(127);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  while (!fs::exists(out + "/report.json") &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const json report = read_json_file(out + "/report.json");
+  EXPECT_TRUE(report["interrupted"].get<bool>());
+  EXPECT_FALSE(report["complete"].get<bool>());
+  EXPECT_EQ(report["shard"]["index"], 1);
+  expect_refused({"slow-1"}, "shard 1/2 was interrupted");
+}
+
+TEST_F(Merge, BadShardValueExitsTwo) {
+  const std::string bin = test::accelbench_bin();
+  for (const char* bad : {"4/3", "0/3", "x"}) {
+    const std::string err_file = dir_ + "/bad-shard.err";
+    EXPECT_EQ(shell("'" + bin + "' run '" + dir_ + "/tiny.json' --shard '" + bad + "' -o '" + dir_ +
+                    "/bad-shard' 2> '" + err_file + "'"),
+              2);
+    const std::string err = read_text(err_file);
+    EXPECT_EQ(err.rfind("accelbench: --shard: ", 0), 0u) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad-shard"));
+  }
 }
 
 }  // namespace
