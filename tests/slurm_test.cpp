@@ -45,7 +45,9 @@ class LocalCluster {
   }
   LocalCluster(const LocalCluster&) = delete;
   LocalCluster& operator=(const LocalCluster&) = delete;
+  /// Whether slurm-local-up succeeded.
   bool up() const { return up_; }
+  /// What slurm-local-up said (with the daemons' log tails when it failed).
   std::string log() const { return read_text(dir_ + "/up.err"); }
 
  private:
