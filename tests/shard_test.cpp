@@ -118,7 +118,7 @@ TEST(Shard, ShardJsonRecordsThePartitionAndHashTellsSuitesApart) {
   EXPECT_EQ(suite_hash(suite.json).rfind("fnv1a64:", 0), 0u);
 }
 
-/// A tiny suite's shards, run once for the merge tests (a few seconds).
+/// A folder with a tiny suite (and a variant of it) whose shards the merge tests run (a second or two).
 class Merge : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -135,6 +135,9 @@ class Merge : public ::testing::Test {
     json other = json::parse(suite);
     other["seed"] = 4;
     std::ofstream(dir_ + "/other.json") << other.dump();
+  }
+  /// The runs the merge tests read: the tiny suite unsharded and as 3 shards, and shard 2/3 of another suite.
+  static void run_shards() {
     run_ok("tiny.json", "", "single");
     for (int k = 1; k <= 3; ++k) run_ok("tiny.json", std::to_string(k) + "/3", "shard-" + std::to_string(k));
     run_ok("other.json", "2/3", "other-2");
@@ -187,6 +190,7 @@ class Merge : public ::testing::Test {
 std::string Merge::dir_;
 
 TEST_F(Merge, ShardsInAnyOrderGiveTheUnshardedRun) {
+  ASSERT_NO_FATAL_FAILURE(run_shards());
   std::string err;
   ASSERT_EQ(merge({"shard-3", "shard-1", "shard-2"}, "merged", err), 0) << err;
   const json merged = read_json_file(dir_ + "/merged/report.json");
@@ -206,6 +210,7 @@ TEST_F(Merge, ShardsInAnyOrderGiveTheUnshardedRun) {
 }
 
 TEST_F(Merge, RefusesShardsThatDoNotMakeOneRun) {
+  ASSERT_NO_FATAL_FAILURE(run_shards());
   expect_refused({"shard-1", "shard-2"}, "shard 3/3 is missing");
   expect_refused({"shard-1", "shard-2", "shard-2", "shard-3"}, "shard 2/3 given twice");
   expect_refused({"shard-1", "other-2", "shard-3"}, "suite (hash)");
