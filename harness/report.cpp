@@ -124,6 +124,10 @@ void print_verification_line(std::ostream& out, const nlohmann::json& report) {
   uint64_t checks = 0;
   for (const auto& b : report.value("builds", nlohmann::json::array()))
     checks += b.value("verification", nlohmann::json::array()).size();
+  if (report.value("scenes", nlohmann::json::array()).empty()) {
+    out << "verification: none (no scenes)\n";
+    return;
+  }
   if (checks == 0) {
     out << "verification: none (no ray sets: builds only)\n";
     return;

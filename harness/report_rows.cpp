@@ -4,6 +4,7 @@
 
 #include "harness/machine.h"
 #include "harness/report.h"
+#include "harness/shard.h"
 #include "harness/timing.h"
 
 namespace ab {
@@ -37,6 +38,7 @@ json report_header(const Suite& suite) {
           {"suite_name", suite.name},
           {"suite_source", suite.source},
           {"suite", suite.json},
+          {"suite_hash", suite_hash(suite.json)},
           {"machine", machine_info()},
           {"compiler", compiler_info()},
           {"source", source_info()},
@@ -45,6 +47,7 @@ json report_header(const Suite& suite) {
           {"verification", verification_method(suite.verify)},
           {"verified", true},
           {"interrupted", false},
+          {"complete", false},
           {"failures", json::array()},
           {"scenes", json::array()},
           {"builds", json::array()},

@@ -37,7 +37,7 @@ class Runner {
   FailureSink failure_sink() {
     return [this](const std::string& what) { fail(what); };
   }
-  void save();
+  void save(bool finished = false);
   void run_scene(const SceneSpec& scene);
   Target load(const SceneSpec& scene) const;
   std::vector<RaySet> make_ray_sets(const Target& target) const;
@@ -80,10 +80,11 @@ void Runner::fail(const std::string& what) {
   std::cerr << c.red << "VERIFICATION FAILED: " << what << c.reset << "\n";
 }
 
-void Runner::save() {
+void Runner::save(bool finished) {
   fill_ratios(report_);
   fill_correlations(report_, suite_.threads.front());
   report_["interrupted"] = interrupted_;
+  report_["complete"] = finished && !interrupted_;
   write_report(report_, options_.out_dir);
   const std::string gbench = timer_.gbench_json();
   write_file_atomically((std::filesystem::path(options_.out_dir) / "gbench.json").string(),
@@ -92,6 +93,7 @@ void Runner::save() {
 
 json Runner::run() {
   report_ = report_header(suite_);
+  if (!options_.shard.is_null()) report_["shard"] = options_.shard;
   for (const SceneSpec& scene : suite_.scenes) {
     if (stopping()) break;
     run_scene(scene);
@@ -99,7 +101,7 @@ json Runner::run() {
   }
   stopping();
   progress_.finish();
-  save();
+  save(true);
   return report_;
 }
 

@@ -18,11 +18,14 @@ struct RunOptions {
   bool progress = false;                           ///< draw the progress bar on stderr
   bool color = false;                              ///< red failure lines on stderr
   const std::atomic<bool>* interrupted = nullptr;  ///< set by SIGINT: stop after the current case
+  /// When the suite is one shard of a larger one: what the report records under "shard" (harness/shard.h).
+  nlohmann::json shard;
 };
 
 /// Runs the suite and returns the report (also written to out_dir after every scene and at the end,
 /// with gbench.json beside it). report["verified"] is false when any check failed; report["interrupted"]
-/// is true when the run stopped early (finished cases are kept).
+/// is true when the run stopped early (finished cases are kept); report["complete"] is true only in the final
+/// save of a run that was not interrupted (a report saved between scenes, then killed, says false).
 nlohmann::json run_suite(const Suite& suite, const RunOptions& options);
 
 }  // namespace ab
