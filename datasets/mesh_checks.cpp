@@ -35,6 +35,7 @@ struct PlyLayout {
   bool list = false;
   int bytes = 0;
   PlyType count{0, false, false};
+  bool integer = false;  ///< the scalar (or the list's entries) has an integer type
 };
 
 /// What the header check has seen of one element.
@@ -49,6 +50,28 @@ struct PlyElement {
 
 std::string ply_line_error(const std::string& path, size_t line, const std::string& what) {
   return path + ":" + std::to_string(line) + ": " + what;
+}
+
+/// OpenMesh reads the header token by token and loops forever once its stream fails, which a token
+/// left over on a line (read as the next keyword or count) makes it do: every line must end where its
+/// keyword's fields end.
+void expect_line_end(std::istringstream& words, const std::string& path, size_t line) {
+  std::string extra;
+  if (words >> extra)
+    throw InputError(ply_line_error(path, line, "unexpected '" + extra + "' at the end of the header line"));
+}
+
+/// Parses the count of an element line: a whole non-negative number below 2^31 (what OpenMesh reads).
+long long ply_element_count(std::istringstream& words, const std::string& path, size_t line) {
+  std::string token;
+  words >> token;
+  long long count = -1;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), count);
+  if (token.empty() || ec != std::errc() || end != token.data() + token.size() || count < 0 ||
+      count > 0x7FFFFFFF)
+    throw InputError(ply_line_error(
+        path, line, "malformed element line (the count '" + token + "' is not a number in [0, 2^31))"));
+  return count;
 }
 
 /// Checks one property line ("property TYPE NAME" or "property list COUNT_TYPE INDEX_TYPE NAME").
@@ -66,16 +89,18 @@ void check_ply_property(std::istringstream& words, PlyElement* element, const st
           ply_line_error(path, line, "a list's count type must be an integer type, not " + count_type));
     element->lists.insert(name);
     element->properties.emplace_back(name, true);
-    element->layout.push_back({true, kPlyTypes.at(index_type).bytes, kPlyTypes.at(count_type)});
+    element->layout.push_back(
+        {true, kPlyTypes.at(index_type).bytes, kPlyTypes.at(count_type), !kPlyTypes.at(index_type).is_float});
     element->min_bytes += uint64_t(kPlyTypes.at(count_type).bytes);
   } else {
     if (!(words >> name) || !kPlyTypes.count(type))
       throw InputError(ply_line_error(path, line, "malformed property (unknown type '" + type + "')"));
     element->scalars.insert(name);
     element->properties.emplace_back(name, false);
-    element->layout.push_back({false, kPlyTypes.at(type).bytes, {}});
+    element->layout.push_back({false, kPlyTypes.at(type).bytes, {}, !kPlyTypes.at(type).is_float});
     element->min_bytes += uint64_t(kPlyTypes.at(type).bytes);
   }
+  expect_line_end(words, path, line);
 }
 
 /// Checks what the elements declare: a vertex element with x, y, z and a list on the face element.
@@ -122,22 +147,30 @@ void check_ply_face_list(std::string_view& rest, long long vertices, long long f
 /// Checks one element line of an ASCII PLY body against the element's properties.
 void check_ply_ascii_line(std::string_view rest, const PlyElement& e, long long index, long long vertices,
                           const std::string& path, size_t line) {
-  for (const auto& [name, list] : e.properties) {
+  const auto number = [&](std::string_view token, bool integer) {
+    return integer ? double(ply_integer(token, path, line)) : double(parse_float(token, path, line));
+  };
+  for (size_t p = 0; p < e.properties.size(); ++p) {
+    const auto& [name, list] = e.properties[p];
+    const bool integer = e.layout[p].integer;
     if (list && e.name == "face" && (name == "vertex_indices" || name == "vertex_index")) {
       check_ply_face_list(rest, vertices, index + 1, path, line);
     } else if (list) {
       const long long n = ply_integer(next_token(rest), path, line);
       if (n < 0) throw InputError(ply_line_error(path, line, "negative list length " + std::to_string(n)));
-      for (long long k = 0; k < n; ++k) parse_float(next_token(rest), path, line);
+      for (long long k = 0; k < n; ++k) number(next_token(rest), integer);
     } else {
       const std::string_view token = next_token(rest);
       if (token.empty()) throw InputError(ply_line_error(path, line, "too few values for element " + e.name));
-      const float f = parse_float(token, path, line);
-      if (e.name == "vertex" && (name == "x" || name == "y" || name == "z") && !std::isfinite(f))
+      const double f = number(token, integer);
+      if (e.name == "vertex" && (name == "x" || name == "y" || name == "z") && !std::isfinite(float(f)))
         throw InputError(ply_line_error(
             path, line, "vertex " + std::to_string(index + 1) + " has a NaN or infinite coordinate"));
     }
   }
+  // OpenMesh reads the body token by token: a value too many would shift every value after it.
+  if (!next_token(rest).empty())
+    throw InputError(ply_line_error(path, line, "too many values for element " + e.name));
 }
 
 /// OpenMesh's ASCII PLY reader turns an unparsable number into silent garbage, so the body is
@@ -175,6 +208,7 @@ std::string check_ply_format(std::istringstream& words, const std::string& path,
   if (!number || version.size() > 16)
     throw InputError(ply_line_error(
         path, line, "the format line needs a version number such as 1.0, got '" + version + "'"));
+  expect_line_end(words, path, line);
   return kind;
 }
 
@@ -264,7 +298,7 @@ void check_ply_binary_body(std::istream& in, const std::vector<PlyElement>& elem
 void check_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string text, keyword;
-  if (!std::getline(in, text) || text.substr(0, 3) != "ply")
+  if (!std::getline(in, text) || (text != "ply" && text != "ply\r"))
     throw InputError(path + ": not a PLY file (no 'ply' magic)");
   std::vector<PlyElement> elements;
   bool format = false, ascii = false, big_endian = false;
@@ -273,6 +307,7 @@ void check_ply(const std::string& path) {
     std::istringstream words(text);
     if (!(words >> keyword) || keyword == "comment" || keyword == "obj_info") continue;
     if (keyword == "end_header") {
+      expect_line_end(words, path, line);
       if (!format) throw InputError(path + ": the PLY header has no format line");
       check_ply_elements(elements, path);
       if (ascii)
@@ -288,9 +323,10 @@ void check_ply(const std::string& path) {
       format = true;
     } else if (keyword == "element") {
       PlyElement e;
-      e.count = -1;
-      if (!(words >> e.name >> e.count) || e.count < 0)
-        throw InputError(ply_line_error(path, line, "malformed element line"));
+      if (!(words >> e.name))
+        throw InputError(ply_line_error(path, line, "malformed element line (no name)"));
+      e.count = ply_element_count(words, path, line);
+      expect_line_end(words, path, line);
       elements.push_back(e);
     } else if (keyword == "property") {
       check_ply_property(words, elements.empty() ? nullptr : &elements.back(), path, line);

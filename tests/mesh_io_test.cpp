@@ -337,8 +337,8 @@ TEST_F(MeshIoTest, BinaryPlyBodyMustHoldTheDeclaredElements) {
   ply.replace(ply.find("vertex 8"), 8, "vertex 1000000");
   expect_input_error(write("big.ply", ply), "unexpected end of file in vertex ");
   std::string faces = ply_binary_text(true);
-  faces.replace(faces.find("face 8"), 6, "face 4000000000");
-  expect_input_error(write("faces.ply", faces), "unexpected end of file in face 9 of 4000000000");
+  faces.replace(faces.find("face 8"), 6, "face 2000000000");
+  expect_input_error(write("faces.ply", faces), "unexpected end of file in face 9 of 2000000000");
   // A list as long as its int count says (2^31 - 1 entries; OpenMesh tried to read them all).
   std::string list = ply_header("binary_little_endian", 3, 1);
   list.replace(list.find("list uchar"), 10, "list int");
@@ -353,7 +353,34 @@ TEST_F(MeshIoTest, BinaryPlyBodyMustHoldTheDeclaredElements) {
   std::string ascii_list = ply_header("ascii", 1, 0);
   ascii_list.replace(ascii_list.find("element face"), 0, "property list int float extra\n");
   expect_input_error(write("negative2.ply", ascii_list + "0 0 0 -1\n"), ":11: negative list length -1");
-  expect_input_error(write("2p32.ply", ply_header("ascii", 4294967296ull, 0)), "truncated");
+  expect_input_error(write("2p32.ply", ply_header("ascii", 4294967296ull, 0)), "not a number in [0, 2^31)");
+}
+
+TEST_F(MeshIoTest, PlyHeaderLinesEndWhereTheirFieldsEnd) {
+  // OpenMesh reads the header token by token: "element vertex 5element" made it loop forever, writing
+  // an error message each time (found by fuzz_ply, fuzz/regressions/ply/element_count_suffix_timeout.ply).
+  const std::string good = ply_binary_text(false);
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  expect_input_error(write("a.ply", with("vertex 8\n", "vertex 8element\n")), ":3: malformed element line");
+  expect_input_error(write("b.ply", with("vertex 8\n", "vertex 8 9\n")), ":3: unexpected '9'");
+  expect_input_error(write("c.ply", with("float x\n", "float x y\n")), ":4: unexpected 'y'");
+  expect_input_error(write("d.ply", with("1.0\n", "1.0 1.0\n")), ":2: unexpected '1.0'");
+  expect_input_error(write("e.ply", with("end_header\n", "end_header x\n")), "unexpected 'x'");
+  expect_input_error(write("f.ply", with("vertex 8\n", "vertex\n")), "malformed element line");
+  expect_input_error(write("g.ply", with("ply\n", "plyx\n")), "not a PLY file");
+  // ASCII bodies are read token by token too: a value too many would shift the rest.
+  const std::string header = ply_header("ascii", 3, 1);
+  expect_input_error(write("h.ply", header + "0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n"), ":10: too many values");
+  expect_input_error(write("i.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 5\n"), ":13: too many values");
+  std::string int_header = header;
+  int_header.replace(int_header.find("float x"), 7, "int x");
+  expect_input_error(write("j.ply", int_header + "0 0 0\n1.5 0 0\n0 1 0\n3 0 1 2\n"),
+                     "'1.5' is not an integer");
+  EXPECT_EQ(read_mesh(write("k.ply", int_header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).size(), 1u);
 }
 
 TEST_F(MeshIoTest, OffVariantsAndSameLineCounts) {
