@@ -1,5 +1,6 @@
-// Mesh files: OBJ, PLY (ASCII and binary), OFF and STL, read through OpenMesh's readers with the
-// contract's id rule (face order kept, polygons fan-triangulated, every face kept).
+// Mesh files: OBJ, PLY (ASCII and binary), OFF (ASCII) and STL with the contract's id rule (face order
+// kept, polygons fan-triangulated, every face kept): PLY through OpenMesh's reader after checks of our
+// own, OBJ, OFF and STL by readers of our own.
 #pragma once
 
 #include <string>

@@ -1,6 +1,7 @@
 #include "harness/suite.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -43,8 +44,10 @@ void check_keys(const json& obj, const Where& w, const std::set<std::string>& al
 }
 
 uint64_t read_count(const json& j, const Where& w, uint64_t lo, uint64_t hi) {
-  if (!j.is_number_integer() &&
-      !(j.is_number_float() && j.get<double>() == double(uint64_t(j.get<double>()))))
+  // A float must be a whole number in [0, 2^64) before it is converted (converting others is undefined).
+  const bool whole_float = j.is_number_float() && j.get<double>() >= 0.0 && j.get<double>() < 0x1p64 &&
+                           j.get<double>() == std::floor(j.get<double>());
+  if (!j.is_number_integer() && !whole_float)
     w.fail(std::string("expected a non-negative integer, got ") + j.dump());
   const double as_double = j.get<double>();
   if (as_double < double(lo) || as_double > double(hi))
@@ -70,6 +73,9 @@ std::string param_text(const json& v, const Where& w) {
   w.fail("expected a number, string or boolean (or a list of them), got " + v.dump());
 }
 
+/// Most configurations one entry's parameter lists may expand into.
+constexpr size_t kMaxCombinations = 4096;
+
 /// Expands {"k": [a, b], "m": c} into every combination, in key order with the last key varying fastest.
 std::vector<std::map<std::string, std::string>> expand_grid(const json& params, const Where& w) {
   std::vector<std::map<std::string, std::string>> out{{}};
@@ -84,6 +90,9 @@ std::vector<std::map<std::string, std::string>> expand_grid(const json& params, 
     } else {
       values.push_back(param_text(value, wk));
     }
+    // Each list multiplies the combinations: bound them (a short file could ask for billions).
+    if (out.size() * values.size() > kMaxCombinations)
+      wk.fail("the parameter lists give more than " + std::to_string(kMaxCombinations) + " combinations");
     std::vector<std::map<std::string, std::string>> next;
     for (const auto& partial : out)
       for (const auto& v : values) {
@@ -302,7 +311,7 @@ Suite read_suite(const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, and out_of_range for a number like 1e400
     std::string what = e.what();
     const auto colon = what.find("] ");
     throw InputError(path +

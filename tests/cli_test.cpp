@@ -148,6 +148,36 @@ TEST_F(Cli, BadInputGivesExitTwoOneLineAndNoOutput) {
     EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << "left behind: " << entry.path();
 }
 
+// Every input fuzzing found (fuzz/regressions/) through the real binary: a valid file loads (exit 0), a
+// bad one gets exit 2 and one line naming it; never a crash, an abort or a hang, and no output left.
+TEST_F(Cli, FuzzedInputsExitZeroOrTwoWithOneLine) {
+  ASSERT_EQ(run("generate soup --triangles 50 -o " + path("m.obj")).code, 0);
+  ASSERT_EQ(run("rays --mesh " + path("m.obj") + " --kind incoherent --count 8 -o " + path("r.rays")).code,
+            0);
+  const fs::path regressions = fs::path(ACCELBENCH_SOURCE_DIR) / "fuzz" / "regressions";
+  size_t files = 0;
+  for (const char* format : {"obj", "ply", "off", "stl", "suite"}) {
+    if (!fs::is_directory(regressions / format)) continue;
+    for (const auto& entry : fs::directory_iterator(regressions / format)) {
+      const std::string file = entry.path().string();
+      SCOPED_TRACE(file);
+      ++files;
+      const std::string out = path("out");
+      const Result r =
+          std::string(format) == "suite"
+              ? run("run " + file + " -o " + out)
+              : run("trace --mesh " + file + " --accel brute --rays " + path("r.rays") + " -o " + out);
+      if (std::string(format) == "suite" || r.code != 0)
+        expect_bad_input(r, entry.path().filename().string());
+      if (r.code != 0) {
+        EXPECT_FALSE(fs::exists(out));
+      }
+      fs::remove_all(out);
+    }
+  }
+  EXPECT_GE(files, 20u);
+}
+
 TEST_F(Cli, VerifyAgreesWithEmbree) {
   ASSERT_EQ(run("generate terrain --triangles 5000 -o " + path("t.obj")).code, 0);
   const Result r = run("verify --mesh " + path("t.obj") + " --kind primary --count 4000");

@@ -318,6 +318,112 @@ TEST_F(MeshIoTest, MalformedContent) {
   expect_input_error(write("n.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"), "");
 }
 
+// ---- fuzzing findings (fuzz/regressions/; each was a hang, an abort or a huge allocation) ----
+
+TEST_F(MeshIoTest, PlyVersionMustBeANumber) {
+  // OpenMesh's header reader looped forever on a version its stream could not read.
+  const std::string body =
+      "\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  for (const char* version : {"x", "1e999", "", "1.0x", "nan", "1."})
+    expect_input_error(write("v.ply", std::string("ply\nformat ascii ") + version + body), "version number");
+  expect_input_error(write("b.ply", "ply\nformat binary_little_endian x" + body),
+                     ":2: the format line needs");
+  EXPECT_EQ(read_mesh(write("ok.ply", "ply\nformat ascii 1" + body)).size(), 0u);
+}
+
+TEST_F(MeshIoTest, BinaryPlyBodyMustHoldTheDeclaredElements) {
+  // OpenMesh read the declared number of elements past the end of the file (minutes for 10^6).
+  std::string ply = ply_binary_text(false);
+  ply.replace(ply.find("vertex 8"), 8, "vertex 1000000");
+  expect_input_error(write("big.ply", ply), "unexpected end of file in vertex ");
+  std::string faces = ply_binary_text(true);
+  faces.replace(faces.find("face 8"), 6, "face 2000000000");
+  expect_input_error(write("faces.ply", faces), "unexpected end of file in face 9 of 2000000000");
+  // A list as long as its int count says (2^31 - 1 entries; OpenMesh tried to read them all).
+  std::string list = ply_header("binary_little_endian", 3, 1);
+  list.replace(list.find("list uchar"), 10, "list int");
+  for (int i = 0; i < 9; ++i) put4(list, 0.0f, false);
+  for (int n : {0x7FFFFFFF, 0, 1, 2}) put4(list, n, false);
+  expect_input_error(write("list.ply", list), "unexpected end of file in face 1 of 1");
+  list.replace(list.size() - 16, 4, "\xff\xff\xff\xff");
+  expect_input_error(write("negative.ply", list), "face 1 has a negative list length");
+  std::string float_count = ply_header("ascii", 3, 1);
+  float_count.replace(float_count.find("list uchar"), 10, "list float");
+  expect_input_error(write("float.ply", float_count), "count type must be an integer type");
+  std::string ascii_list = ply_header("ascii", 1, 0);
+  ascii_list.replace(ascii_list.find("element face"), 0, "property list int float extra\n");
+  expect_input_error(write("negative2.ply", ascii_list + "0 0 0 -1\n"), ":11: negative list length -1");
+  expect_input_error(write("2p32.ply", ply_header("ascii", 4294967296ull, 0)), "not a number in [0, 2^31)");
+}
+
+TEST_F(MeshIoTest, PlyHeaderLinesEndWhereTheirFieldsEnd) {
+  // OpenMesh reads the header token by token: "element vertex 5element" made it loop forever, writing
+  // an error message each time (found by fuzz_ply, fuzz/regressions/ply/element_count_suffix_timeout.ply).
+  const std::string good = ply_binary_text(false);
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  expect_input_error(write("a.ply", with("vertex 8\n", "vertex 8element\n")), ":3: malformed element line");
+  expect_input_error(write("b.ply", with("vertex 8\n", "vertex 8 9\n")), ":3: unexpected '9'");
+  expect_input_error(write("c.ply", with("float x\n", "float x y\n")), ":4: unexpected 'y'");
+  expect_input_error(write("d.ply", with("1.0\n", "1.0 1.0\n")), ":2: unexpected '1.0'");
+  expect_input_error(write("e.ply", with("end_header\n", "end_header x\n")), "unexpected 'x'");
+  expect_input_error(write("f.ply", with("vertex 8\n", "vertex\n")), "malformed element line");
+  expect_input_error(write("g.ply", with("ply\n", "plyx\n")), "not a PLY file");
+  // ASCII bodies are read token by token too: a value too many would shift the rest.
+  const std::string header = ply_header("ascii", 3, 1);
+  expect_input_error(write("h.ply", header + "0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n"), ":10: too many values");
+  expect_input_error(write("i.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 5\n"), ":13: too many values");
+  std::string int_header = header;
+  int_header.replace(int_header.find("float x"), 7, "int x");
+  expect_input_error(write("j.ply", int_header + "0 0 0\n1.5 0 0\n0 1 0\n3 0 1 2\n"),
+                     "'1.5' is not an integer");
+  EXPECT_EQ(read_mesh(write("k.ply", int_header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).size(), 1u);
+}
+
+TEST_F(MeshIoTest, OffVariantsAndSameLineCounts) {
+  const std::string tri = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::vector<glm::uvec3> one = {{0, 1, 2}};
+  EXPECT_EQ(read_mesh(write("s.off", "OFF 3 1 0\n" + tri)).triangles, one);
+  EXPECT_EQ(read_mesh(write("c.off", "# c\nOFF\n# c\n3 1 0 # c\n" + tri)).triangles, one);
+  const Mesh colour = read_mesh(write(
+      "c2.off", "COFF\n3 2 0\n0 0 0 1 0 0 1\n1 0 0 0 1 0 1\n0 1 0 0 0 1 1\n3 0 1 2 255 0 0\n3 2 1 0\n"));
+  EXPECT_EQ(colour.triangles, (std::vector<glm::uvec3>{{0, 1, 2}, {2, 1, 0}}));
+  EXPECT_EQ(colour.vertices[1], vec3(1, 0, 0));
+  EXPECT_EQ(
+      read_mesh(write("n.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n")).triangles,
+      one);
+  EXPECT_EQ(read_mesh(write("st.off",
+                            "STCNOFF\n3 1 0\n0 0 0 0 0 1 1 1 1 0 0\n1 0 0 0 0 1 1 1 1 1 0\n"
+                            "0 1 0 0 0 1 1 1 1 0 1\n3 0 1 2\n"))
+                .triangles,
+            one);
+}
+
+TEST_F(MeshIoTest, FuzzedOffFilesAreOneLineErrors) {
+  std::string binary = "OFF BINARY\n";
+  for (uint32_t n : {0u, 1000000u, 0u}) put4(binary, n, false);  // hung OpenMesh for ~1000 s
+  expect_input_error(write("bin.off", binary), "binary OFF is not supported");
+  expect_input_error(write("coff.off", "COFF\n"), "no vertex and face counts");    // OpenMesh: random counts
+  expect_input_error(write("offof.off", "OFFOF"), "unknown OFF keyword 'OFFOF'");  // OpenMesh: 16 GB
+  expect_input_error(write("noff.off", "NOFF\n3 1 0\n"), "truncated: vertex 1 is missing");
+  expect_input_error(write("coff2.off", "COFF\n3 1 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n"),
+                     "vertex 3 is missing");
+  expect_input_error(write("4off.off", "4OFF\n3 1 0\n"), "not supported");
+  expect_input_error(write("noff2.off", "nOFF\n4\n3 1 0\n"), "not supported");
+  expect_input_error(write("same.off", "OFF 0 0\n1 4000000000\n"), "unexpected content after the last face");
+  expect_input_error(write("t.off", "OFF 0 0\n1 122222222222222222222\n"), "unexpected content");
+  expect_input_error(write("corners.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n"),
+                     ":6: expected a vertex index");
+  expect_input_error(write("neg.off", "OFF\n-3 1 0\n"), ":2: expected the vertex count, got '-3'");
+  expect_input_error(write("huge.off", "OFF\n99999999999999999999 1 0\n"), "expected the vertex count");
+  expect_input_error(write("many.off", "OFF\n1000000000 0 0\n0 0 0\n"), "vertex 2 is missing");
+  expect_input_error(write("none.off", "ply\n"), "not an OFF file");
+  expect_input_error(write("stcoff.off", "STCOFF\n5 000007211644586605 5 0\n0 * 0\n"), "'*' is not a number");
+}
+
 /// Triangle count of a real mesh in ../shared/meshes, or skips when it is absent.
 void expect_real_mesh(const std::string& name, size_t faces) {
   const std::string file = std::string(ACCELBENCH_SOURCE_DIR "/../shared/meshes/") + name;

@@ -163,6 +163,59 @@ TEST(Suite, UnreadableOrInvalidFileIsOneLine) {
   }
 }
 
+/// The message of the InputError that read_suite throws for a file holding `text` ("" when none).
+std::string read_error_of(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  try {
+    read_suite(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Fuzzing findings (fuzz/regressions/suite): a number out of double's range aborted the process
+// (nlohmann's out_of_range escaped), and out-of-range or fractional counts were converted to integers
+// (undefined behaviour) before the range check.
+TEST(Suite, FuzzedNumbersAreOneLineErrors) {
+  const std::string path = ::testing::TempDir() + "s_1e400.json";
+  const std::string huge = read_error_of("s_1e400.json", R"({"seed": 1e400})");
+  EXPECT_EQ(huge.rfind(path + ": invalid JSON: ", 0), 0u) << huge;
+  EXPECT_NE(huge.find("1e400"), std::string::npos) << huge;
+  EXPECT_EQ(huge.find('\n'), std::string::npos) << huge;
+  const BadCase cases[] = {
+      {R"({"seed": 1e20})", "s.json: seed: expected a non-negative integer, got 1e+20"},
+      {R"({"seed": -1.5})", "s.json: seed: expected a non-negative integer, got -1.5"},
+      {R"({"repetitions": 2.5})", "s.json: repetitions: expected a non-negative integer"},
+      {R"({"repetitions": -1e300})", "s.json: repetitions: expected a non-negative integer"},
+      {R"({"scenes": [{"generator": "soup", "triangles": 1.8446744073709552e19}]})",
+       "s.json: scenes[0].triangles: expected a non-negative integer"},
+      {R"({"threads": [1e19]})", "s.json: threads[0]: 1e+19 is outside [0, 4096]"},
+  };
+  for (const BadCase& c : cases) {
+    json j = minimal_suite();
+    j.merge_patch(json::parse(c.patch));
+    const std::string message = error_of(j);
+    EXPECT_EQ(message.rfind(c.expected, 0), 0u) << "patch " << c.patch << "\n  got: " << message;
+  }
+  json whole = minimal_suite();
+  whole["seed"] = 7.0;
+  EXPECT_EQ(parse_suite(whole, "s.json", "").seed, 7u);
+}
+
+// A short file must not expand into billions of configurations (memory exhaustion).
+TEST(Suite, ParameterGridIsBounded) {
+  json j = minimal_suite();
+  json params = json::object();
+  for (const char* key : {"a", "b", "c", "d", "e", "f", "g", "h"})
+    params[key] = json::parse("[1, 2, 3, 4, 5, 6, 7, 8]");
+  j["accelerators"] = json::array({{{"name", "brute"}, {"params", params}}});
+  const std::string message = error_of(j);
+  EXPECT_EQ(message.rfind("s.json: accelerators[0].params.e: the parameter lists give more than 4096", 0), 0u)
+      << message;
+}
+
 TEST(Suite, RelativePathsResolveAgainstTheSuiteFolder) {
   json j = minimal_suite();
   j["scenes"] = json::parse(R"([{"mesh": "meshes/a.obj"}])");
