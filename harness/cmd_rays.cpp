@@ -29,7 +29,8 @@ const CommandRegistrar kRays{
        app.add_option("--seed", a->seed, "random seed");
        app.add_option("-o,--output", a->output, "output .rays file")->required();
        return [a] {
-         const Target target = load_target(a->target.mesh, a->target.scene);
+         const Target target =
+             load_target(a->target.mesh, a->target.scene, a->target.frame.normalized_time());
          // Scenes: the tracer's own kinds (camera and lights of the scene).
          const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed);
          write_rays(a->output, rays);

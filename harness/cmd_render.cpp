@@ -1,7 +1,7 @@
 // `accelbench render --scene F [--accel NAME] [--accel-top NAME] [--accel-bottom NAME] [--spp N]
 //  [--width W] [--height H] [--max-depth D] [--seed S] [--threads T]
 //  [--heatmap [--metric nodes|prims] [--scale-max V]]
-//  [--param k=v ...] -o FILE.png`
+//  [--param k=v ...] [--time T | --frame F --frames N | --frames A-B] -o FILE.png`
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -14,6 +14,7 @@
 #include "harness/target.h"
 #include "harness/terminal.h"
 #include "harness/timing.h"
+#include "tracer/animation.h"
 #include "tracer/heatmap.h"
 #include "tracer/integrator.h"
 #include "tracer/scene.h"
@@ -23,6 +24,7 @@ namespace {
 
 struct RenderArgs {
   std::string scene;
+  FrameOptions frame;
   std::string accel;
   StructureOptions structure;
   std::string output;
@@ -33,8 +35,8 @@ struct RenderArgs {
   float scale_max = 0.0f;
 };
 
-int run_render(const RenderArgs& a) {
-  const Target target = load_target("", a.scene);
+/// Renders one frame (the target's scene) to `output`; prints one summary line.
+void render_frame(const Target& target, const RenderArgs& a, const std::string& output) {
   const Scene& scene = *target.scene;
   RenderOptions opt = render_options(scene);
   if (a.spp) opt.spp = a.spp;
@@ -43,7 +45,7 @@ int run_render(const RenderArgs& a) {
   if (a.max_depth) opt.max_depth = a.max_depth;
   opt.seed = a.seed;
   opt.threads = a.threads;
-  opt.progress = progress_callback("rendering " + a.output);
+  opt.progress = progress_callback("rendering " + output);
   const std::string name = a.accel.empty() ? default_structure() : a.accel;
   std::unique_ptr<Accelerator> accel = make_target_accelerator(target, name, params_from(a.structure.params),
                                                                a.structure.top, a.structure.bottom);
@@ -63,11 +65,40 @@ int run_render(const RenderArgs& a) {
     out = to_srgb8(render(scene, *accel, opt, &counts));
   }
   const double seconds = seconds_since(start);
-  write_png(out, a.output);
+  write_png(out, output);
   std::printf("%s: %dx%d, %d spp, %s: build %.3f s, render %.3f s, %llu rays (%.2f Mrays/s)\n",
-              a.output.c_str(), opt.width, opt.height, opt.spp, accel->name().c_str(),
+              output.c_str(), opt.width, opt.height, opt.spp, accel->name().c_str(),
               accel->stats().build_seconds, seconds, static_cast<unsigned long long>(counts.total()),
               seconds > 0 ? double(counts.total()) / seconds / 1e6 : 0.0);
+}
+
+/// `--frames A-B`: frames A..B of the scene's `<render><frames>` count, one PNG each, named by the
+/// output pattern (one %d or %0Nd). Every frame uses the same seed, so the images do not depend on threads.
+int render_animation(const RenderArgs& a, uint64_t first, uint64_t last) {
+  std::string probe;
+  if (!frame_file_name(a.output, first, probe))
+    throw InputError("-o " + a.output + ": --frames A-B needs an output pattern with one %d or %0Nd");
+  const Scene scene = load_scene(a.scene);
+  const auto count = uint64_t(scene.render.frames);
+  if (last >= count)
+    throw InputError("--frames " + a.frame.frames + ": out of range, " + a.scene + " has " +
+                     std::to_string(count) + " frames (0.." + std::to_string(count - 1) + ")");
+  for (uint64_t f = first; f <= last; ++f) {
+    std::string output;
+    frame_file_name(a.output, f, output);
+    auto at = std::make_shared<const Scene>(scene_at(scene, frame_time(f, count)));
+    render_frame(scene_target(std::move(at), a.scene), a, output);
+  }
+  return 0;
+}
+
+int run_render(const RenderArgs& a) {
+  uint64_t first = 0, last = 0;
+  if (a.frame.range(first, last)) {
+    a.frame.normalized_time(true);  // the other combinations' checks
+    return render_animation(a, first, last);
+  }
+  render_frame(load_target("", a.scene, a.frame.normalized_time()), a, a.output);
   return 0;
 }
 
@@ -75,7 +106,10 @@ const CommandRegistrar kRender{
     {"render", "render a scene with the tracer (PNG), or a heatmap of traversal work", 70,
      [](CLI::App& app) -> std::function<int()> {
        auto a = std::make_shared<RenderArgs>();
-       app.add_option("--scene", a->scene, "scene file (.xml)")->required()->check(CLI::ExistingFile);
+       app.add_option("--scene", a->scene, "scene file (.xml, .gltf, .glb)")
+           ->required()
+           ->check(CLI::ExistingFile);
+       a->frame.add(app);
        app.add_option("--accel", a->accel, "accelerator at both levels (default bvh-sah)")
            ->check(accelerator_name_validator());
        a->structure.add(app);
@@ -91,7 +125,9 @@ const CommandRegistrar kRender{
        app.add_option("--scale-max", a->scale_max,
                       "heatmap: value at the top of the colour scale (default: the image's maximum)")
            ->check(CLI::PositiveNumber);
-       app.add_option("-o,--output", a->output, "output .png file")->required();
+       app.add_option("-o,--output", a->output,
+                      "output .png file (with --frames A-B: a pattern, name_%04d.png)")
+           ->required();
        return [a] { return run_render(*a); };
      }}};
 

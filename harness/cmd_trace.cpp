@@ -25,7 +25,7 @@ struct TraceArgs {
 };
 
 int run_trace(const TraceArgs& a) {
-  const Target target = load_target(a.target.mesh, a.target.scene);
+  const Target target = load_target(a.target.mesh, a.target.scene, a.target.frame.normalized_time());
   const std::vector<Ray> rays = read_rays(a.rays);
   std::unique_ptr<Accelerator> accel = make_target_accelerator(
       target, a.accel, params_from(a.structure.params), a.structure.top, a.structure.bottom);

@@ -49,7 +49,7 @@ std::vector<Hit> trace_with(const Target& target, const std::string& name, const
 }
 
 int run_verify(const VerifyArgs& a) {
-  const Target target = load_target(a.target.mesh, a.target.scene);
+  const Target target = load_target(a.target.mesh, a.target.scene, a.target.frame.normalized_time());
   std::vector<Ray> rays;
   if (!a.rays.empty())
     rays = read_rays(a.rays);

@@ -19,16 +19,21 @@ Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name) {
   return t;
 }
 
-Target load_target(const std::string& mesh_path, const std::string& scene_path) {
+Target scene_target(std::shared_ptr<const Scene> scene, std::string path) {
+  Target t;
+  t.path = std::move(path);
+  t.triangles = scene->triangle_count();
+  t.bounds = scene->world_bounds();
+  t.scene = std::move(scene);
+  return t;
+}
+
+Target load_target(const std::string& mesh_path, const std::string& scene_path, float time) {
   if (mesh_path.empty() == scene_path.empty()) throw InputError("give exactly one of --mesh and --scene");
   if (!scene_path.empty()) {
-    Target t;
-    t.path = scene_path;
-    auto scene = std::make_shared<const Scene>(load_scene(scene_path));
-    t.triangles = scene->triangle_count();
-    t.bounds = scene->world_bounds();
-    t.scene = std::move(scene);
-    return t;
+    Scene loaded = load_scene(scene_path);
+    if (time != 0.0f && loaded.animated()) loaded = scene_at(loaded, time);
+    return scene_target(std::make_shared<const Scene>(std::move(loaded)), scene_path);
   }
   return mesh_target(std::make_shared<const Mesh>(read_mesh(mesh_path)), mesh_path);
 }

@@ -23,8 +23,11 @@ struct Target {
   AABB bounds;                         ///< world bounds
 };
 
-/// Loads --mesh F or --scene F (exactly one non-empty). Throws InputError naming the file.
-Target load_target(const std::string& mesh_path, const std::string& scene_path);
+/// Loads --mesh F or --scene F (exactly one non-empty); a scene at normalized time `time` (a static
+/// scene, and a mesh, ignore it). Throws InputError naming the file.
+Target load_target(const std::string& mesh_path, const std::string& scene_path, float time = 0.0f);
+/// Wraps an in-memory scene (a frame of an animation).
+Target scene_target(std::shared_ptr<const Scene> scene, std::string path);
 /// Wraps an in-memory mesh (generated meshes in suites and tests).
 Target mesh_target(std::shared_ptr<const Mesh> mesh, std::string name);
 

@@ -15,10 +15,13 @@
 #include "accel/core/params.h"
 #include "datasets/generators.h"
 #include "datasets/mesh_io.h"
+#include "tracer/gltf.h"
 
 namespace ab {
 
 namespace {
+
+void set_time_range(Scene& scene);
 
 /// Reads a scene document: one pass for the declarations (meshes, materials, transforms, camera,
 /// lights, settings), a second for the instances, so declarations may appear in any order.
@@ -43,8 +46,8 @@ class SceneParser {
     for (pugi::xml_node n : root.children()) declaration(n);
     for (pugi::xml_node n : root.children("instance")) instance(n);
     if (scene_.instances.empty()) fail(root, "the scene has no <instance>");
-    scene_.bounds = scene_.compute_world_bounds();
-    return std::move(scene_);
+    set_time_range(scene_);
+    return scene_at(scene_, 0.0f);
   }
 
  private:
@@ -121,6 +124,18 @@ class SceneParser {
                   std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v;
   }
+  /// A finite number given as attribute `name` of n (`def` when absent).
+  float attribute_number(const pugi::xml_node& n, const char* name, float def = 0.0f) const {
+    const pugi::xml_attribute a = n.attribute(name);
+    if (!a) return def;
+    const std::string s = a.value();
+    const char* b = s.data() + (s.size() && s[0] == '+' ? 1 : 0);
+    float v = 0.0f;
+    const auto [ptr, ec] = std::from_chars(b, s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v))
+      fail(n, "attribute " + std::string(name) + "=\"" + s + "\" must be a finite number");
+    return v;
+  }
   static std::string fmt(float v) {
     std::ostringstream os;
     os << v;
@@ -190,13 +205,14 @@ class SceneParser {
   void render(const pugi::xml_node& n) {
     check_attributes(n, {});
     RenderSettings& r = scene_.render;
-    children(n, {"width", "height", "spp", "maxdepth", "diffusedepth"},
+    children(n, {"width", "height", "spp", "maxdepth", "diffusedepth", "frames"},
              [&](const pugi::xml_node& c, const std::string& k) {
                if (k == "width") r.width = integer_in(c, 1, 16384);
                if (k == "height") r.height = integer_in(c, 1, 16384);
                if (k == "spp") r.spp = integer_in(c, 1, 65536);
                if (k == "maxdepth") r.max_depth = integer_in(c, 1, 64);
                if (k == "diffusedepth") r.diffuse_depth = integer_in(c, 0, 64);
+               if (k == "frames") r.frames = integer_in(c, 1, 1'000'000);
              });
   }
 
@@ -264,27 +280,108 @@ class SceneParser {
 
   // ---- meshes ----
   void mesh(const pugi::xml_node& n) {
-    check_attributes(n, {"name", "file", "generator", "triangles", "seed"});
+    check_attributes(
+        n, {"name", "file", "generator", "triangles", "seed", "frames", "count", "first", "start", "end"});
     SceneMesh m;
     m.name = required_attribute(n, "name");
     if (mesh_index_.count(m.name)) fail(n, "mesh '" + m.name + "' declared twice");
-    const bool file = n.attribute("file"), gen = n.attribute("generator");
-    if (file && gen) fail(n, "<mesh> takes either file or generator, not both");
+    const bool file = n.attribute("file"), gen = n.attribute("generator"), frames = n.attribute("frames");
+    if (int(file) + int(gen) + int(frames) > 1) fail(n, "<mesh> takes one of file, generator or frames");
     if (!gen && (n.attribute("triangles") || n.attribute("seed")))
       fail(n, "triangles and seed apply only to a generator mesh");
+    if (!frames &&
+        (n.attribute("count") || n.attribute("first") || n.attribute("start") || n.attribute("end")))
+      fail(n, "count, first, start and end apply only to a frames mesh");
     if (file) {
-      if (n.first_child()) fail(n, "a <mesh> with a file has no children");
-      m.mesh = std::make_shared<Mesh>(load_mesh_file(n, required_attribute(n, "file")));
+      children(n, {"deform"}, [](const pugi::xml_node&, const std::string&) {});
+      m.base = std::make_shared<Mesh>(load_mesh_file(n, required_attribute(n, "file")));
       m.source = std::string("file ") + n.attribute("file").value();
     } else if (gen) {
-      m.mesh = std::make_shared<Mesh>(generated_mesh(n));
+      m.base = std::make_shared<Mesh>(generated_mesh(n));
       m.source = std::string("generator ") + n.attribute("generator").value();
+    } else if (frames) {
+      m.animation = frame_sequence(n);
+      m.base = m.animation.frames.front();
+      m.source = std::string("frames ") + n.attribute("frames").value();
     } else {
-      m.mesh = std::make_shared<Mesh>(inline_mesh(n));
+      m.base = std::make_shared<Mesh>(inline_mesh(n));
       m.source = "inline";
     }
+    if (const pugi::xml_node d = n.child("deform")) m.animation = deformer(d);
+    m.mesh = m.base;
     mesh_index_[m.name] = static_cast<uint32_t>(scene_.meshes.size());
     scene_.meshes.push_back(std::move(m));
+  }
+
+  /// The frame files of a `frames` mesh: pattern with one %d (or %0Nd), `count` files numbered from
+  /// `first`, all with the first one's triangle count.
+  MeshAnimation frame_sequence(const pugi::xml_node& n) const {
+    children(n, {}, [](const pugi::xml_node&, const std::string&) {});
+    const std::string pattern = required_attribute(n, "frames");
+    if (!n.attribute("count")) fail(n, "a frames <mesh> needs attribute 'count'");
+    const uint64_t count = attribute_integer(n, "count", 1, 1, 100000);
+    const uint64_t first = attribute_integer(n, "first", 0, 0, 1'000'000'000);
+    MeshAnimation a;
+    a.kind = MeshAnimation::Kind::kFrames;
+    a.start = attribute_number(n, "start", 0.0f);
+    a.end = attribute_number(n, "end", 1.0f);
+    if (!(a.end > a.start)) fail(n, "a frames <mesh> needs end > start");
+    for (uint64_t k = 0; k < count; ++k) {
+      std::string file;
+      if (!frame_file_name(pattern, first + k, file))
+        fail(n, "frames=\"" + pattern + "\" needs exactly one %d or %0Nd (and no other %)");
+      auto mesh = std::make_shared<const Mesh>(load_mesh_file(n, file));
+      if (k > 0 && mesh->size() != a.frames.front()->size())
+        fail(n, file + ": frame has " + std::to_string(mesh->size()) + " triangles, the first frame " +
+                    std::to_string(a.frames.front()->size()) + " (every frame needs the same triangles)");
+      a.frames.push_back(std::move(mesh));
+    }
+    return a;
+  }
+
+  /// A <deform type="wave|twist|explode" start="t0" end="t1"> and its parameters.
+  MeshAnimation deformer(const pugi::xml_node& d) const {
+    check_attributes(d, {"type", "start", "end"});
+    Deformer f;
+    const std::string type = required_attribute(d, "type");
+    std::set<std::string> allowed;
+    if (type == "wave") {
+      f.kind = Deformer::Kind::kWave;
+      allowed = {"amplitude", "wavelength", "cycles", "axis", "direction"};
+    } else if (type == "twist") {
+      f.kind = Deformer::Kind::kTwist;
+      allowed = {"degrees", "axis"};
+    } else if (type == "explode") {
+      f.kind = Deformer::Kind::kExplode;
+      allowed = {"distance"};
+    } else {
+      fail(d, "unknown deformer type '" + type + "' (known: wave, twist, explode)");
+    }
+    f.start = attribute_number(d, "start", 0.0f);
+    f.end = attribute_number(d, "end", 1.0f);
+    if (!(f.end > f.start)) fail(d, "a <deform> needs end > start");
+    const float big = std::numeric_limits<float>::max();
+    children(d, allowed, [&](const pugi::xml_node& c, const std::string& k) {
+      check_attributes(c, {});
+      if (k == "amplitude") f.amplitude = number_in(c, -big, big);
+      if (k == "wavelength") f.wavelength = number_in(c, 1e-6f, big);
+      if (k == "cycles") f.cycles = number_in(c, -big, big);
+      if (k == "degrees") f.degrees = number_in(c, -big, big);
+      if (k == "distance") f.distance = number_in(c, -big, big);
+      if (k == "axis") f.axis = unit_vector(c);
+      if (k == "direction") f.direction = unit_vector(c);
+    });
+    MeshAnimation a;
+    a.kind = MeshAnimation::Kind::kDeformer;
+    a.deformer = f;
+    return a;
+  }
+
+  vec3 unit_vector(const pugi::xml_node& c) const {
+    const vec3 v = vector3(c);
+    const float len = glm::length(v);
+    if (!(len > 0.0f) || !std::isfinite(len)) fail(c, "<" + std::string(c.name()) + "> must not be zero");
+    return v / len;
   }
 
   Mesh load_mesh_file(const pugi::xml_node& n, const std::string& file) const {
@@ -302,7 +399,8 @@ class SceneParser {
     const uint64_t tris = attribute_integer(n, "triangles", 1000, 1, 100'000'000);
     const uint64_t seed = attribute_integer(n, "seed", 1, 0, std::numeric_limits<uint64_t>::max());
     Params params;
-    children(n, {"param"}, [&](const pugi::xml_node& c, const std::string&) {
+    children(n, {"param", "deform"}, [&](const pugi::xml_node& c, const std::string& k) {
+      if (k == "deform") return;
       check_attributes(c, {});
       try {
         params.add(c.child_value());
@@ -320,7 +418,8 @@ class SceneParser {
   Mesh inline_mesh(const pugi::xml_node& n) const {
     Mesh mesh;
     pugi::xml_node tri_node;
-    children(n, {"vertices", "triangles"}, [&](const pugi::xml_node& c, const std::string& k) {
+    children(n, {"vertices", "triangles", "deform"}, [&](const pugi::xml_node& c, const std::string& k) {
+      if (k == "deform") return;
       check_attributes(c, {});
       const std::vector<float> v = numbers(c, 0);
       if (v.size() % 3) fail(c, "<" + k + "> needs a multiple of 3 numbers, got " + std::to_string(v.size()));
@@ -341,47 +440,133 @@ class SceneParser {
   }
 
   // ---- transforms and instances ----
-  /// Appends one transform element (translate, rotate, scale, matrix) of parent to x.
-  void transform_element(const pugi::xml_node& parent, const pugi::xml_node& c, Transform& x) const {
+  /// One transform element (translate, rotate, scale, matrix) of parent as a constant animated element.
+  AnimatedElement transform_element(const pugi::xml_node& parent, const pugi::xml_node& c) const {
+    using Kind = AnimatedElement::Kind;
     const std::string k = c.name();
+    AnimatedElement e;
+    e.times = {0.0f};
     if (k == "translate") {
       check_attributes(c, {});
-      x.then(translate_matrix(vector3(c)));
+      e.kind = Kind::kTranslate;
+      e.values = {numbers(c, 3)};
     } else if (k == "scale") {
       check_attributes(c, {});
-      const std::vector<float> v = numbers(c, 0);
+      std::vector<float> v = numbers(c, 0);
       if (v.size() != 1 && v.size() != 3)
         fail(c, "<scale> needs 1 or 3 numbers, got " + std::to_string(v.size()));
-      x.then(scale_matrix(v.size() == 1 ? vec3(v[0]) : vec3(v[0], v[1], v[2])));
+      if (v.size() == 1) v = {v[0], v[0], v[0]};
+      e.kind = Kind::kScale;
+      e.values = {v};
     } else if (k == "rotate") {
       check_attributes(c, {"axis"});
-      x.then(rotate_matrix(rotation_axis(c), number(c)));
+      e.kind = Kind::kRotate;
+      e.axis = rotation_axis(c);
+      e.values = {{number(c)}};
     } else if (k == "matrix") {
       check_attributes(c, {});
       const std::vector<float> v = numbers(c, 16);
-      glm::mat4 m;
+      std::vector<float> m(16);
       for (int r = 0; r < 4; ++r)
-        for (int col = 0; col < 4; ++col) m[col][r] = v[size_t(r * 4 + col)];  // rows in the file
-      x.then(m);
+        for (int col = 0; col < 4; ++col)
+          m[size_t(col * 4 + r)] = v[size_t(r * 4 + col)];  // rows in the file
+      e.kind = Kind::kMatrix;
+      e.values = {m};
     } else {
       fail(c, "unknown element <" + k + "> in <" + parent.name() + ">");
     }
+    return e;
   }
 
-  /// Appends every element child of n, in document order; an unnamed <transform> child (only when
-  /// `nested` is true) contributes its own elements at its place.
-  void transform_elements(const pugi::xml_node& n, Transform& x, bool nested) const {
-    for (pugi::xml_node c : n.children()) {
+  /// The elements of one <keyframe> (plain elements only) and its time.
+  std::vector<AnimatedElement> keyframe(const pugi::xml_node& k, float& time) const {
+    check_attributes(k, {"time"});
+    const pugi::xml_attribute a = k.attribute("time");
+    if (!a) fail(k, "<keyframe> needs attribute 'time'");
+    time = attribute_number(k, "time");
+    std::vector<AnimatedElement> out;
+    for (pugi::xml_node c : k.children()) {
+      if (c.type() == pugi::node_pcdata &&
+          std::string(c.value()).find_first_not_of(" \t\r\n") != std::string::npos)
+        fail(c, "unexpected text in <keyframe>");
+      if (c.type() == pugi::node_element) {
+        out.push_back(transform_element(k, c));
+        out.back().times = {time};
+      }
+    }
+    return out;
+  }
+
+  /// A run of consecutive <keyframe> siblings starting at `first` as one animated segment: every keyframe
+  /// has the same element sequence (kinds, and axes of rotations), the times strictly increase; element
+  /// i takes its values from the i-th element of each keyframe. Returns the node after the run.
+  pugi::xml_node keyframes(pugi::xml_node first, AnimatedTransform& x) const {
+    std::vector<AnimatedElement> merged;
+    pugi::xml_node c = first;
+    for (; c; c = c.next_sibling()) {
+      if (c.type() == pugi::node_pcdata &&
+          std::string(c.value()).find_first_not_of(" \t\r\n") == std::string::npos)
+        continue;
+      if (c.type() == pugi::node_comment) continue;
+      if (c.type() != pugi::node_element || std::string(c.name()) != "keyframe") break;
+      float time = 0.0f;
+      std::vector<AnimatedElement> elements = keyframe(c, time);
+      if (merged.empty()) {
+        merged = std::move(elements);
+        if (merged.empty()) fail(c, "a <keyframe> needs at least one element");
+        continue;
+      }
+      same_sequence(c, merged, elements);
+      if (!(time > merged.front().times.back()))
+        fail(c, "keyframe times must increase: " + fmt(time) + " after " + fmt(merged.front().times.back()));
+      for (size_t i = 0; i < merged.size(); ++i) {
+        merged[i].times.push_back(time);
+        merged[i].values.push_back(elements[i].values.front());
+      }
+    }
+    for (AnimatedElement& e : merged) x.elements.push_back(std::move(e));
+    return c;
+  }
+
+  /// Fails unless `next` has the element sequence of `merged` (kinds, rotation axes).
+  void same_sequence(const pugi::xml_node& k, const std::vector<AnimatedElement>& merged,
+                     const std::vector<AnimatedElement>& next) const {
+    if (next.size() != merged.size())
+      fail(k, "keyframes must have the same elements: this one has " + std::to_string(next.size()) +
+                  ", the first " + std::to_string(merged.size()));
+    for (size_t i = 0; i < next.size(); ++i) {
+      if (next[i].kind != merged[i].kind)
+        fail(k, "keyframes must have the same elements in the same order: element " + std::to_string(i + 1) +
+                    " differs from the first keyframe's");
+      if (next[i].kind == AnimatedElement::Kind::kRotate && next[i].axis != merged[i].axis)
+        fail(k, "keyframes must rotate about the same axis: element " + std::to_string(i + 1) +
+                    " differs from the first keyframe's");
+    }
+  }
+
+  /// Appends every element child of n, in document order; a run of <keyframe> children is one animated
+  /// segment at its place; an unnamed <transform> child (only when `nested` is true) contributes its own
+  /// elements at its place.
+  void transform_elements(const pugi::xml_node& n, AnimatedTransform& x, bool nested) const {
+    for (pugi::xml_node c = n.first_child(); c;) {
       if (c.type() == pugi::node_pcdata &&
           std::string(c.value()).find_first_not_of(" \t\r\n") != std::string::npos)
         fail(c, "unexpected text in <" + std::string(n.name()) + ">");
-      if (c.type() != pugi::node_element) continue;
+      if (c.type() != pugi::node_element) {
+        c = c.next_sibling();
+        continue;
+      }
+      if (std::string(c.name()) == "keyframe") {
+        c = keyframes(c, x);
+        continue;
+      }
       if (nested && std::string(c.name()) == "transform") {
         check_attributes(c, {});
         transform_elements(c, x, false);
       } else {
-        transform_element(n, c, x);
+        x.elements.push_back(transform_element(n, c));
       }
+      c = c.next_sibling();
     }
   }
 
@@ -399,18 +584,25 @@ class SceneParser {
     return v;
   }
 
-  Transform finished(const pugi::xml_node& n, Transform x) const {
-    if (!x.finish()) fail(n, "the transform is singular (zero scale?) or not finite");
-    return x;
+  /// Fails when the transform is singular at any of its key times.
+  void check_regular(const pugi::xml_node& n, const AnimatedTransform& x) const {
+    std::set<float> times = {0.0f};
+    for (const AnimatedElement& e : x.elements) times.insert(e.times.begin(), e.times.end());
+    Transform t;
+    for (float time : times)
+      if (!x.evaluate(time, t))
+        fail(n, "the transform is singular (zero scale?) or not finite" +
+                    (x.animated() ? " at time " + fmt(time) : std::string()));
   }
 
   void named_transform(const pugi::xml_node& n) {
     check_attributes(n, {"name"});
     const std::string name = required_attribute(n, "name");
     if (transforms_.count(name)) fail(n, "transform '" + name + "' declared twice");
-    Transform x;
+    AnimatedTransform x;
     transform_elements(n, x, false);
-    transforms_[name] = finished(n, x);
+    check_regular(n, x);
+    transforms_[name] = x;
   }
 
   void instance(const pugi::xml_node& n) {
@@ -424,7 +616,7 @@ class SceneParser {
       if (!material_index_.count(mat)) fail(n, "unknown material '" + mat + "'");
       inst.material = material_index_.at(mat);
     }
-    Transform x;
+    AnimatedTransform x;
     if (n.attribute("transform")) {
       const std::string name = required_attribute(n, "transform");
       if (!transforms_.count(name)) fail(n, "unknown transform '" + name + "'");
@@ -432,25 +624,70 @@ class SceneParser {
     }
     // Inline elements (directly or in an unnamed <transform>) follow the named one in document order.
     transform_elements(n, x, true);
-    inst.transform = finished(n, x);
-    scene_.instances.push_back(inst);
+    check_regular(n, x);
+    inst.animation = std::move(x);
+    scene_.instances.push_back(std::move(inst));
   }
 
   const std::string& text_;
   std::string path_, base_dir_;
   Scene scene_;
   std::map<std::string, uint32_t> mesh_index_, material_index_;
-  std::map<std::string, Transform> transforms_;
+  std::map<std::string, AnimatedTransform> transforms_;
   bool default_replaced_ = false;
 };
 
+/// The scene-time range of every animated transform and mesh.
+void set_time_range(Scene& scene) {
+  bool any = false;
+  const auto add = [&](float first, float last) {
+    scene.time_first = any ? std::min(scene.time_first, first) : first;
+    scene.time_last = any ? std::max(scene.time_last, last) : last;
+    any = true;
+  };
+  float first = 0.0f, last = 0.0f;
+  for (const SceneInstance& inst : scene.instances)
+    if (inst.animation.animated()) {
+      inst.animation.time_range(first, last);
+      add(first, last);
+    }
+  for (const SceneMesh& m : scene.meshes)
+    if (m.animation.animated()) {
+      m.animation.time_range(first, last);
+      add(first, last);
+    }
+}
+
 }  // namespace
+
+Scene scene_at(const Scene& scene, float u) {
+  Scene out = scene;
+  out.time = u;
+  const float t = scene.time_first + u * (scene.time_last - scene.time_first);
+  for (SceneMesh& m : out.meshes)
+    if (m.animation.animated()) m.mesh = m.animation.at(m.base, t);
+  for (size_t i = 0; i < out.instances.size(); ++i)
+    if (!out.instances[i].animation.evaluate(t, out.instances[i].transform))
+      throw InputError(scene.path + ": the transform of instance " + std::to_string(i) +
+                       " is singular or not finite at time " + std::to_string(u));
+  out.bounds = out.compute_world_bounds();
+  return out;
+}
+
+float frame_time(uint64_t frame, uint64_t frames) {
+  if (frames == 0) throw InputError("--frames must be at least 1");
+  if (frame >= frames)
+    throw InputError("--frame " + std::to_string(frame) + " is out of range: " + std::to_string(frames) +
+                     " frames are 0.." + std::to_string(frames - 1));
+  return frames == 1 ? 0.0f : float(double(frame) / double(frames - 1));
+}
 
 Scene parse_scene(const std::string& text, const std::string& path, const std::string& base_dir) {
   return SceneParser(text, path, base_dir).parse();
 }
 
 Scene load_scene(const std::string& path) {
+  if (is_gltf_path(path)) return load_gltf_scene(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open scene file");
   std::ostringstream ss;
