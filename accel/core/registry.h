@@ -84,23 +84,4 @@ structure_info(std::string name, std::string description, int order) {
   return info;
 }
 
-/// The same for a structure whose constructor still reads its own parameters (S<P>(prims, Params&)).
-/// Transitional: removed when every structure has a Config.
-template <template <class> class S>
-AcceleratorInfo legacy_structure_info(std::string name, std::string description, int order) {
-  AcceleratorInfo info;
-  info.name = std::move(name);
-  info.description = std::move(description);
-  info.order = order;
-  info.make_for_mesh = [](std::shared_ptr<const TrianglePrims> p,
-                          Params& params) -> std::unique_ptr<Accelerator> {
-    return std::make_unique<S<TrianglePrims>>(std::move(p), params);
-  };
-  info.make_for_instances = [](std::shared_ptr<const InstancePrims> p,
-                               Params& params) -> std::unique_ptr<Accelerator> {
-    return std::make_unique<S<InstancePrims>>(std::move(p), params);
-  };
-  return info;
-}
-
 }  // namespace ab
