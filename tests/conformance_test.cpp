@@ -1,20 +1,20 @@
 // Every registered structure of the project against brute force: byte-identical hits, the same
 // occlusion answers, at 1 and 2 threads, as bottom and as top level, on adversarial meshes and rays,
 // on every generator and ray kind, and on the real meshes. New structures are covered by registering.
-#include "accel/reference/brute.h"
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "accel/core/registry.h"
 #include "accel/core/trace.h"
+#include "accel/reference/brute.h"
 #include "datasets/generators.h"
 #include "datasets/mesh_io.h"
 #include "datasets/random.h"
 #include "datasets/rays.h"
 #include "harness/compare.h"
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <gtest/gtest.h>
-
-#include <cstring>
-#include <filesystem>
 
 namespace ab {
 namespace {
@@ -27,7 +27,9 @@ std::vector<std::string> structure_names() {
   return names;
 }
 
-std::shared_ptr<const Mesh> share(Mesh m) { return std::make_shared<const Mesh>(std::move(m)); }
+std::shared_ptr<const Mesh> share(Mesh m) {
+  return std::make_shared<const Mesh>(std::move(m));
+}
 
 void add_triangle(Mesh& m, vec3 a, vec3 b, vec3 c) {
   const uint32_t base = static_cast<uint32_t>(m.vertices.size());
@@ -79,9 +81,9 @@ Mesh nasty_mix() {
   for (int i = 0; i < 40; ++i) {
     const vec3 a = rng.unit_cube(), b = rng.unit_cube(), c = rng.unit_cube();
     add_triangle(m, a, b, c);
-    if (i % 5 == 0) add_triangle(m, a, b, c);          // exact duplicate
-    if (i % 7 == 0) add_triangle(m, a, a, a);          // point
-    if (i % 6 == 0) add_triangle(m, a, b, b);          // repeated vertex
+    if (i % 5 == 0) add_triangle(m, a, b, c);               // exact duplicate
+    if (i % 7 == 0) add_triangle(m, a, a, a);               // point
+    if (i % 6 == 0) add_triangle(m, a, b, b);               // repeated vertex
     if (i % 9 == 0) add_triangle(m, a, 0.5f * (a + b), b);  // collinear
   }
   add_triangle(m, {-1000, -1000, -1000}, {1000, -1000, -1000}, {1000, 1000, -1000});  // the stadium floor
@@ -120,11 +122,13 @@ std::vector<Ray> adversarial_rays(const Mesh& mesh, const AABB& box, uint64_t se
       rays.push_back({o, target - o, 0.0f, kInf});  // at a vertex / edge / centre, t = 1
     }
     rays.push_back({tri.centroid(), rng.unit_sphere(), 0.0f, kInf});  // starting on the surface
-    Ray in_plane{tri.v0 - vec3(b.extent().x + 1, 0, 0), vec3(1, 0, 0), 0.0f, kInf};  // in the axis planes of v0
+    Ray in_plane{tri.v0 - vec3(b.extent().x + 1, 0, 0), vec3(1, 0, 0), 0.0f,
+                 kInf};  // in the axis planes of v0
     rays.push_back(in_plane);
     // Lying in the triangle's own (generally oblique) plane, along an edge direction and across it.
     rays.push_back({tri.v0 - (tri.v1 - tri.v0), tri.v1 - tri.v0, 0.0f, kInf});
-    rays.push_back({tri.v0 - 0.5f * (tri.v1 + tri.v2 - 2.0f * tri.v0), 0.5f * (tri.v1 + tri.v2) - tri.v0, 0.0f, kInf});
+    rays.push_back(
+        {tri.v0 - 0.5f * (tri.v1 + tri.v2 - 2.0f * tri.v0), 0.5f * (tri.v1 + tri.v2) - tri.v0, 0.0f, kInf});
     Ray limited{point(), tri.centroid(), 0.0f, 1.0f};
     limited.dir = tri.centroid() - limited.org;
     rays.push_back(limited);  // tmax exactly at the hit
@@ -150,10 +154,10 @@ void expect_same_as_brute(const Accelerator& accel, const Accelerator& brute, co
     std::vector<Hit> hits(rays.size());
     trace_closest(accel, rays, hits, threads);
     const IdenticalResult r = compare_identical(expected, hits);
-    ASSERT_TRUE(r.identical()) << what << ", " << threads << " thread(s): " << r.differing << " of " << rays.size()
-                               << " rays differ; first ray " << r.first_differences.front()
-                               << ": expected " << hit_string(expected[r.first_differences.front()]) << ", got "
-                               << hit_string(hits[r.first_differences.front()]);
+    ASSERT_TRUE(r.identical()) << what << ", " << threads << " thread(s): " << r.differing << " of "
+                               << rays.size() << " rays differ; first ray " << r.first_differences.front()
+                               << ": expected " << hit_string(expected[r.first_differences.front()])
+                               << ", got " << hit_string(hits[r.first_differences.front()]);
   }
   std::vector<Hit> counted(rays.size());
   const RayCounters c = trace_closest_counted(accel, rays, counted, 2);
@@ -162,7 +166,8 @@ void expect_same_as_brute(const Accelerator& accel, const Accelerator& brute, co
   std::vector<uint8_t> occluded(rays.size());
   trace_occluded(accel, rays, occluded, 2);
   for (size_t i = 0; i < rays.size(); ++i)
-    ASSERT_EQ(occluded[i] != 0, expected[i].found()) << what << ": occluded() disagrees with brute on ray " << i;
+    ASSERT_EQ(occluded[i] != 0, expected[i].found())
+        << what << ": occluded() disagrees with brute on ray " << i;
 }
 
 void check_mesh(const std::string& name, std::shared_ptr<const Mesh> mesh, const std::vector<Ray>& rays,
@@ -210,7 +215,8 @@ TEST_P(Conformance, EveryGeneratorAndRayKind) {
       const std::vector<Ray> rays = make_rays(kind.name, target, 1500, 3);
       expect_same_as_brute(*accel, *brute, rays, gen.name + " / " + kind.name);
     }
-    expect_same_as_brute(*accel, *brute, adversarial_rays(*mesh, mesh->bounds(), 13), gen.name + " / adversarial");
+    expect_same_as_brute(*accel, *brute, adversarial_rays(*mesh, mesh->bounds(), 13),
+                         gen.name + " / adversarial");
   }
 }
 

@@ -1,7 +1,7 @@
+#include <gtest/gtest.h>
+
 #include "accel/core/box_test.h"
 #include "accel/core/triangle.h"
-
-#include <gtest/gtest.h>
 
 namespace ab {
 namespace {

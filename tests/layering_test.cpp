@@ -31,7 +31,8 @@ std::map<std::string, std::vector<std::string>> include_graph() {
       std::smatch m;
       auto& includes = graph[file];
       while (std::getline(in, line))
-        if (std::regex_search(line, m, include_line) && fs::exists(root / m[1].str())) includes.push_back(m[1]);
+        if (std::regex_search(line, m, include_line) && fs::exists(root / m[1].str()))
+          includes.push_back(m[1]);
     }
   }
   return graph;

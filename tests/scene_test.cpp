@@ -12,10 +12,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "accel/reference/embree_scene.h"
 #include "accel/core/error.h"
 #include "accel/core/registry.h"
 #include "accel/core/trace.h"
+#include "accel/reference/embree_scene.h"
 #include "tracer/sampling.h"
 #include "tracer/scene_accel.h"
 #include "tracer/workload.h"

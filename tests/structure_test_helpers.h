@@ -1,12 +1,6 @@
 // Small inline meshes, ray sets and a brute-force comparison for the structure tests (bvh, grid).
 #pragma once
 
-#include "accel/reference/brute.h"
-#include "accel/core/instances.h"
-#include "accel/core/mesh.h"
-#include "accel/core/primitives.h"
-#include "accel/core/registry.h"
-
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -16,10 +10,18 @@
 #include <string>
 #include <vector>
 
+#include "accel/core/instances.h"
+#include "accel/core/mesh.h"
+#include "accel/core/primitives.h"
+#include "accel/core/registry.h"
+#include "accel/reference/brute.h"
+
 namespace ab::testing {
 
 /// Uniform float in [lo, hi) from a 32-bit generator (portable: no std distributions).
-inline float uniform(std::mt19937& rng, float lo, float hi) { return lo + (hi - lo) * float(rng() >> 8) * 0x1p-24f; }
+inline float uniform(std::mt19937& rng, float lo, float hi) {
+  return lo + (hi - lo) * float(rng() >> 8) * 0x1p-24f;
+}
 
 /// Random triangle soup: n triangles of size about `size` in the unit cube.
 inline Mesh random_soup(size_t n, uint32_t seed, float size = 0.05f) {
@@ -28,7 +30,8 @@ inline Mesh random_soup(size_t n, uint32_t seed, float size = 0.05f) {
   for (size_t i = 0; i < n; ++i) {
     const vec3 c(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1));
     for (int k = 0; k < 3; ++k)
-      m.vertices.push_back(c + vec3(uniform(rng, -size, size), uniform(rng, -size, size), uniform(rng, -size, size)));
+      m.vertices.push_back(
+          c + vec3(uniform(rng, -size, size), uniform(rng, -size, size), uniform(rng, -size, size)));
     m.triangles.push_back({uint32_t(3 * i), uint32_t(3 * i + 1), uint32_t(3 * i + 2)});
   }
   return m;
@@ -141,7 +144,8 @@ inline size_t count_differences(const std::string& name, const Mesh& mesh, const
 
 /// A scene of `copies` transformed instances of one base mesh built with `base_name`, returned as the
 /// instance set (for top-level tests).
-inline std::shared_ptr<const InstancePrims> make_instances(const Mesh& mesh, const std::string& base_name, int copies) {
+inline std::shared_ptr<const InstancePrims> make_instances(const Mesh& mesh, const std::string& base_name,
+                                                           int copies) {
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
   std::shared_ptr<Accelerator> base = make_accelerator(base_name, prims, Params());
   base->build();
@@ -181,5 +185,7 @@ inline size_t count_instance_differences(const std::string& name, std::shared_pt
 
 namespace ab::testing {
 /// Params from a key -> value map (avoids the ambiguity of brace-initializing Params directly).
-inline Params make_params(std::map<std::string, std::string> values) { return Params(std::move(values)); }
+inline Params make_params(std::map<std::string, std::string> values) {
+  return Params(std::move(values));
+}
 }  // namespace ab::testing
