@@ -52,10 +52,13 @@ concept RayQueries = requires(const S& s, const Ray& ray, Hit& best, uint32_t in
 
 /// A structure of the project over primitive set S::Prims: an Accelerator with a Config, constructed from the
 /// primitives and that Config (the build is separate), answering both ray queries.
+// (clang-format 14 misreads the template arguments of a concept's requirement as comparisons.)
+// clang-format off
 template <class S>
 concept Structure = std::derived_from<S, Accelerator> && PrimitiveSet<typename S::Prims> &&
-                    StructureConfig<typename S::Config> && RayQueries<S> && std::constructible_from < S,
-        std::shared_ptr<const typename S::Prims>,
-const typename S::Config& > ;
+                    StructureConfig<typename S::Config> && RayQueries<S> &&
+                    std::constructible_from<S, std::shared_ptr<const typename S::Prims>,
+                                            const typename S::Config&>;
+// clang-format on
 
 }  // namespace ab
