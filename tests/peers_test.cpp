@@ -12,7 +12,9 @@
 #include "datasets/mesh_io.h"
 #include "datasets/rays.h"
 #include "harness/compare.h"
+#include "harness/run.h"
 #include "harness/selection.h"
+#include "harness/suite.h"
 #include "harness/target.h"
 #include "harness/verification.h"
 
@@ -218,6 +220,55 @@ TEST(Peers, StatisticsSayWhatIsMeasured) {
     EXPECT_TRUE(s.extra.contains("note")) << peer;
     EXPECT_GT(s.build_seconds, 0.0) << peer;
   }
+}
+
+TEST(Peers, ASuiteTimesThemAndClassifiesTheirHits) {
+  if (built_peers().empty()) GTEST_SKIP() << "neither CGAL nor Bullet was found at build time";
+  nlohmann::json j = nlohmann::json::parse(R"({
+    "repetitions": 2, "warmup": 0, "min_time": 0, "threads": [1],
+    "scenes": [{"generator": "sphereflake", "triangles": 2000}],
+    "rays": [{"kind": "primary", "count": 256}, {"kind": "shadow", "count": 256}],
+    "verify": {"brute_rays": 0, "reference": "bvh-sah", "embree": true}})");
+  j["accelerators"] = {"embree", "bvh-sah"};
+  for (const auto& p : built_peers()) j["accelerators"].push_back(p);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("accelbench_peers_" + std::to_string(::getpid()));
+  RunOptions options;
+  options.out_dir = dir.string();
+  const nlohmann::json report = run_suite(parse_suite(j, "peers.json", ""), options);
+  std::filesystem::remove_all(dir);
+  EXPECT_TRUE(report["verified"].get<bool>()) << report["failures"].dump();
+  std::map<std::string, int> rows;
+  for (const auto& r : report["results"]) {
+    const std::string name = r["accelerator"];
+    ++rows[name];
+    if (name != "cgal" && name != "bullet") continue;
+    EXPECT_EQ(r["classified_against"], "bvh-sah") << name;
+    EXPECT_EQ(r["embree_unexplained"], 0) << name;
+    EXPECT_FALSE(r.contains("brute_mismatches")) << name << " is classified, not held to bytes";
+    EXPECT_TRUE(r["ratio_to_embree"].is_number()) << name;
+    EXPECT_EQ(r["seconds_samples"].size(), 2u) << name;
+  }
+  for (const auto& p : built_peers()) EXPECT_EQ(rows[p], 3) << p;  // primary, shadow closest and any
+}
+
+TEST(Peers, SuitesNameThemAndValidate) {
+  const Suite million = read_suite(ACCELBENCH_SOURCE_DIR "/suites/peers-million.json");
+  const bool both = built_peers().size() == kPeers.size();
+  if (both) {
+    EXPECT_NO_THROW(validate_suite(million));
+  }
+  if (!std::filesystem::exists(ACCELBENCH_SOURCE_DIR "/../shared/meshes/stanford-bunny.obj")) return;
+  const Suite peers = read_suite(ACCELBENCH_SOURCE_DIR "/suites/peers.json");
+  if (both) {
+    EXPECT_NO_THROW(validate_suite(peers));
+  }
+  std::set<std::string> names;
+  for (const auto& a : peers.accelerators) names.insert(a.name);
+  for (const auto& info : accelerators())
+    if (info.name != "brute" && !is_test_only(info.name)) {
+      EXPECT_EQ(names.count(info.name), 1u) << info.name;
+    }
 }
 
 }  // namespace
