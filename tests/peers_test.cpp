@@ -195,6 +195,20 @@ TEST(Peers, AnyHitMatchesWhetherBruteFindsAHit) {
   }
 }
 
+TEST(Peers, AnyHitHonoursTminAndTmax) {
+  const Target target = small_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  const std::vector<Ray> rays{
+      ray({0.25f, 0.125f, 1}, {0, 0, -1}, 0, 2), ray({0.25f, 0.125f, 1}, {0, 0, -1}, 0, 0.5f),
+      ray({0.25f, 0.125f, 1}, {0, 0, -1}, 1.5f, 3), ray({0.25f, 0.125f, 1}, {0, 0, -1}, 2, 0.5f),
+      ray({0.25f, 0.125f, 1}, {0, 0, -1}, 1, 1)};
+  const std::vector<uint8_t> expected{1, 0, 0, 0, 1};
+  for (const auto& peer : built_peers()) {
+    std::vector<uint8_t> out(rays.size());
+    trace_occluded(*built(target, peer), rays, out, 1);
+    EXPECT_EQ(out, expected) << peer;
+  }
+}
+
 TEST(Peers, EmptyMeshBuildsAndMisses) {
   const Target target = small_mesh({}, {});
   for (const auto& peer : built_peers()) {

@@ -134,7 +134,7 @@ void CgalMesh::closest(const Ray& ray, Hit& best, uint32_t inst) const {
 }
 
 bool CgalMesh::any(const Ray& ray) const {
-  if (zero_direction(ray) || !tree_ || tree_->tree.empty()) return false;
+  if (zero_direction(ray) || !(ray.tmin <= ray.tmax) || !tree_ || tree_->tree.empty()) return false;
   const Point source = point_at(ray, ray.tmin);
   if (std::isinf(ray.tmax))
     return tree_->tree.do_intersect(Kernel::Ray_3(source, Kernel::Vector_3(ray.dir.x, ray.dir.y, ray.dir.z)));
