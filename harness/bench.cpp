@@ -90,6 +90,7 @@ Timing summarize(const std::vector<benchmark::BenchmarkReporter::Run>& runs, int
       t.max = s;
   }
   if (per_rep.size() == 1) t.median = t.mean = t.min = t.max = per_rep.front();  // no aggregates for one run
+  t.samples = std::move(per_rep);
   return t;
 }
 

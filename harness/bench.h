@@ -23,6 +23,7 @@ struct Timing {
   double stddev = 0.0;     ///< standard deviation over the repetitions
   int repetitions = 0;     ///< repetitions timed
   int64_t iterations = 0;  ///< passes per repetition
+  std::vector<double> samples;  ///< seconds per pass of each repetition, in order (for `compare`)
 };
 
 /// Passes per repetition so that a repetition lasts at least `min_time` seconds, given one pass's time.

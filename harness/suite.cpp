@@ -181,9 +181,10 @@ std::vector<SceneSpec> parse_scenes(const json& j, const Where& w, const std::st
 }
 
 /// Names "all" stands for: every listed accelerator but brute (too slow to time on real sizes; it is the
-/// verification reference).
+/// verification reference) and the outside peers cgal and bullet (10 to 20 times slower than Embree; a suite
+/// names them, as suites/peers.json does).
 std::vector<std::string> all_accelerator_names() {
-  return listed_accelerators({"brute"});
+  return listed_accelerators({"brute", "cgal", "bullet"});
 }
 
 std::vector<AccelSpec> parse_accelerators(const json& j, const Where& w) {

@@ -37,7 +37,8 @@ nlohmann::json timing_json(const Timing& t) {
           {"mean", t.mean},
           {"stddev", t.stddev},
           {"repetitions", t.repetitions},
-          {"iterations", t.iterations}};
+          {"iterations", t.iterations},
+          {"samples", t.samples}};
 }
 
 nlohmann::json query_timing_fields(const Timing& t, int threads, double rays) {
@@ -50,6 +51,7 @@ nlohmann::json query_timing_fields(const Timing& t, int threads, double rays) {
           {"seconds_max", t.max},
           {"seconds_mean", t.mean},
           {"seconds_stddev", t.stddev},
+          {"seconds_samples", t.samples},
           {"rays_per_second", t.median > 0 ? rays / t.median : 0.0},
           {"rays_per_second_min", t.max > 0 ? rays / t.max : 0.0},
           {"rays_per_second_max", t.min > 0 ? rays / t.min : 0.0}};

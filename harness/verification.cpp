@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "accel/core/registry.h"
 #include "accel/core/trace.h"
 #include "accel/reference/embree_device.h"
 #include "harness/compare.h"
@@ -12,7 +13,8 @@ namespace ab {
 using nlohmann::json;
 
 bool is_exact(const std::string& accelerator) {
-  return accelerator != kEmbreeName;
+  if (accelerator == "brute" || !is_registered(accelerator)) return true;
+  return !find_accelerator(accelerator).is_reference;  // embree, cgal, bullet: classified instead
 }
 
 std::unique_ptr<Accelerator> build_default(const Target& target, const std::string& name) {
@@ -82,7 +84,8 @@ bool verify_identical(const std::string& what, const std::string& reference, con
   return b.identical() && r.identical();
 }
 
-/// The classification against Embree; returns whether every disagreement is explained.
+/// The classification of the pair (ours, theirs) into the embree_* fields; returns whether every
+/// disagreement is explained.
 bool verify_agreement(const Target& target, const std::string& what, const RaySet& set,
                       const std::vector<Hit>& ours, const std::vector<Hit>& theirs, json& v,
                       const FailureSink& fail) {
@@ -94,8 +97,8 @@ bool verify_agreement(const Target& target, const std::string& what, const RaySe
             {"embree_limit", a.limit},
             {"embree_unexplained", a.unexplained}});
   if (a.unexplained == 0) return true;
-  fail(what + ": " + std::to_string(a.unexplained) + " unexplained disagreements with embree " +
-       first_ray(a.unexplained_rays));
+  fail(what + ": " + std::to_string(a.unexplained) + " unexplained disagreements with " +
+       v["classified_against"].get<std::string>() + " " + first_ray(a.unexplained_rays));
   return false;
 }
 
@@ -109,6 +112,9 @@ json verify_hits(const Target& target, const std::string& what, const std::strin
   if (exact && !verify_identical(what, reference, set, hits, v, fail)) v["verified"] = false;
   const std::vector<Hit>& theirs = exact ? set.embree : hits;
   const std::vector<Hit>& ours = exact ? hits : set.reference;
+  // The embree_* counts classify the pair (this row, Embree), or for a reference (embree, cgal, bullet) the
+  // pair (the verified reference structure, this row).
+  v["classified_against"] = exact ? std::string(kEmbreeName) : reference;
   if (!theirs.empty() && !verify_agreement(target, what, set, ours, theirs, v, fail)) v["verified"] = false;
   return v;
 }

@@ -155,8 +155,8 @@ TEST(Run, QuickSuiteEndToEnd) {
     EXPECT_TRUE(r["ratio_to_embree"].is_number());
   }
   for (const auto& info : accelerators())
-    if (info.name.rfind("test-", 0) != 0) {
-      EXPECT_GT(rows_per_accel[info.name], 0) << info.name;
+    if (info.name.rfind("test-", 0) != 0 && info.name != "cgal" && info.name != "bullet") {
+      EXPECT_GT(rows_per_accel[info.name], 0) << info.name;  // "all": the outside peers are left out
     }
   expect_csv_matches_json(report, read_text(dir + "/report.csv"));
   const json gbench = json::parse(read_text(dir + "/gbench.json"));
