@@ -16,13 +16,13 @@ namespace ab {
 
 /// Seconds per pass over the repetitions of one case.
 struct Timing {
-  double median = 0.0;     ///< median over the repetitions
-  double min = 0.0;        ///< fastest repetition
-  double max = 0.0;        ///< slowest repetition
-  double mean = 0.0;       ///< mean over the repetitions
-  double stddev = 0.0;     ///< standard deviation over the repetitions
-  int repetitions = 0;     ///< repetitions timed
-  int64_t iterations = 0;  ///< passes per repetition
+  double median = 0.0;          ///< median over the repetitions
+  double min = 0.0;             ///< fastest repetition
+  double max = 0.0;             ///< slowest repetition
+  double mean = 0.0;            ///< mean over the repetitions
+  double stddev = 0.0;          ///< standard deviation over the repetitions
+  int repetitions = 0;          ///< repetitions timed
+  int64_t iterations = 0;       ///< passes per repetition
   std::vector<double> samples;  ///< seconds per pass of each repetition, in order (for `compare`)
 };
 
