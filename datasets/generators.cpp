@@ -365,6 +365,114 @@ Mesh make_cityscape(uint64_t triangles, uint64_t seed, Params& params) {
   return out.finish(triangles);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Hostile inputs (issue 11): shapes unlike the scanned and procedural scenes above, which stress the
+// termination rules of the space-partitioning trees.
+
+/// Large overlapping triangles: every vertex uniform in a cube of side `size` (CAD or architectural
+/// polygons, where every triangle crosses most of the scene).
+Mesh make_large(uint64_t triangles, uint64_t seed, Params& params) {
+  const float size = static_cast<float>(params.get_float("size", 1.0, 1e-6, 1e6));
+  MeshBuilder out(triangles, 3 * triangles);
+  Rng rng(seed, 20);
+  for (uint64_t i = 0; i < triangles; ++i)
+    out.triangle(size * rng.unit_cube(), size * rng.unit_cube(), size * rng.unit_cube());
+  return out.finish(triangles);
+}
+
+/// A fan: every triangle shares one vertex (the centre of the unit cube); the other two lie at random
+/// directions at distance up to `radius`, so all of them meet in one point.
+Mesh make_fan(uint64_t triangles, uint64_t seed, Params& params) {
+  const float radius = static_cast<float>(params.get_float("radius", 0.5, 1e-6, 1e6));
+  MeshBuilder out(triangles, 2 * triangles + 1);
+  Rng rng(seed, 21);
+  const vec3 apex(0.5f);
+  const uint32_t a = triangles ? out.vertex(apex) : 0;
+  for (uint64_t i = 0; i < triangles; ++i) {
+    const uint32_t b = out.vertex(apex + radius * rng.uniform() * rng.unit_sphere());
+    const uint32_t c = out.vertex(apex + radius * rng.uniform() * rng.unit_sphere());
+    out.triangle(a, b, c);
+  }
+  return out.finish(triangles);
+}
+
+/// Needles: triangles `length` long and `length / aspect` wide at random positions and directions.
+Mesh make_needles(uint64_t triangles, uint64_t seed, Params& params) {
+  const float length = static_cast<float>(params.get_float("length", 0.5, 1e-6, 1e6));
+  const float aspect = static_cast<float>(params.get_float("aspect", 1e4, 1.0, 1e9));
+  MeshBuilder out(triangles, 3 * triangles);
+  Rng rng(seed, 22);
+  for (uint64_t i = 0; i < triangles; ++i) {
+    const vec3 c = rng.unit_cube();
+    const vec3 axis = rng.unit_sphere();
+    vec3 t, b;
+    frame(axis, t, b);
+    const vec3 half = 0.5f * length * axis;
+    out.triangle(c - half, c + half, c + (length / aspect) * t);
+  }
+  return out.finish(triangles);
+}
+
+/// Stacks of coplanar overlapping triangles: `layers` planes z = const across the unit cube, each
+/// holding its share of triangles of side about `size` at random positions, overlapping each other.
+Mesh make_coplanar(uint64_t triangles, uint64_t seed, Params& params) {
+  const uint64_t layers = static_cast<uint64_t>(params.get_int("layers", 4, 1, 1 << 20));
+  const float size = static_cast<float>(params.get_float("size", 0.5, 1e-6, 1e6));
+  MeshBuilder out(triangles, 3 * triangles);
+  Rng rng(seed, 23);
+  for (uint64_t i = 0; i < triangles; ++i) {
+    const float z = static_cast<float>(i % layers + 1) / static_cast<float>(layers + 1);
+    const vec3 c(rng.uniform(), rng.uniform(), z);
+    const auto corner = [&] {
+      return c + size * vec3(rng.uniform(-0.5f, 0.5f), rng.uniform(-0.5f, 0.5f), 0.0f);
+    };
+    const vec3 p = corner(), q = corner();
+    out.triangle(p, q, corner());
+  }
+  return out.finish(triangles);
+}
+
+/// Geometry far from the origin: a soup of small triangles in a cube of side `extent` whose corner is
+/// at (offset, offset, offset), so coordinates are near 1e6 and a float's spacing there (1/16) matters.
+Mesh make_far(uint64_t triangles, uint64_t seed, Params& params) {
+  const float offset = static_cast<float>(params.get_float("offset", 1e6, -1e30, 1e30));
+  const float extent = static_cast<float>(params.get_float("extent", 1000.0, 1e-6, 1e30));
+  const double auto_size =
+      std::min(0.1, 1.5 / std::cbrt(static_cast<double>(std::max<uint64_t>(triangles, 1))));
+  const float size = extent * static_cast<float>(auto_size);
+  MeshBuilder out(triangles, 3 * triangles);
+  Rng rng(seed, 24);
+  for (uint64_t i = 0; i < triangles; ++i) {
+    const vec3 c = vec3(offset) + extent * rng.unit_cube();
+    const vec3 a = c + size * (rng.unit_cube() - 0.5f);
+    const vec3 b = c + size * (rng.unit_cube() - 0.5f);
+    out.triangle(a, b, c + size * (rng.unit_cube() - 0.5f));
+  }
+  return out.finish(triangles);
+}
+
+/// Degenerate and normal triangles mixed (the first row of issue 11): a share `large` of large random
+/// triangles across the unit cube, the rest zero-area ones (a point, or three collinear vertices),
+/// interleaved.
+Mesh make_mixed(uint64_t triangles, uint64_t seed, Params& params) {
+  const double large = params.get_float("large", 0.25, 0.0, 1.0);
+  MeshBuilder out(triangles, 3 * triangles);
+  Rng rng(seed, 25);
+  uint64_t normal = 0;
+  for (uint64_t i = 0; i < triangles; ++i) {
+    const vec3 a = rng.unit_cube(), b = rng.unit_cube();
+    if (static_cast<double>(normal) < large * static_cast<double>(i + 1)) {
+      ++normal;
+      out.triangle(a, b, rng.unit_cube());
+    } else if (i % 2) {
+      out.triangle(a, a, a);
+    } else {
+      out.triangle(a, b, a + rng.uniform() * (b - a));
+    }
+  }
+  return out.finish(triangles);
+}
+
 }  // namespace
 
 const std::vector<GeneratorInfo>& generators() {
@@ -384,6 +492,17 @@ const std::vector<GeneratorInfo>& generators() {
        "axis-aligned boxes on an integer lattice over a ground plane, with duplicate and zero-area triangles "
        "(params height, degenerate)",
        make_cityscape},
+      {"large", "large overlapping triangles: every vertex uniform in the cube (params size)", make_large},
+      {"fan", "a fan: every triangle shares the cube's centre as a vertex (params radius)", make_fan},
+      {"needles", "needles: long triangles of a tiny width at random angles (params length, aspect)",
+       make_needles},
+      {"coplanar", "stacks of coplanar overlapping triangles in planes z = const (params layers, size)",
+       make_coplanar},
+      {"far", "small random triangles in a cube far from the origin, near 1e6 (params offset, extent)",
+       make_far},
+      {"mixed",
+       "large random triangles across the cube mixed with zero-area and collinear ones (params large)",
+       make_mixed},
   };
   return list;
 }

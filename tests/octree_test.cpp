@@ -103,7 +103,8 @@ TEST(Octree, MatchesBruteOnAdversarialMeshesAndInstances) {
 TEST(Octree, RespectsDepthAndLeafSize) {
   const Mesh mesh = random_soup(5000, 9, 0.01f);
   for (int depth : {0, 2, 5}) {
-    const auto accel = built(mesh, {{"max_depth", std::to_string(depth)}, {"leaf_size", "4"}});
+    const auto accel =
+        built(mesh, {{"max_depth", std::to_string(depth)}, {"leaf_size", "4"}, {"auto_depth", "off"}});
     const BuildStats& s = accel->stats();
     EXPECT_LE(s.max_depth, uint32_t(depth));
     EXPECT_EQ((s.nodes - 1) % 8, 0u);  // every interior node has eight children

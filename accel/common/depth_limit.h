@@ -12,4 +12,10 @@ inline int auto_depth_limit(size_t n) {
   return int(std::lround(8.0 + 1.3 * std::log2(double(std::max<size_t>(n, 1)))));
 }
 
+/// The octree's depth limit for n primitives: the same bound in octree levels, each of which is three binary
+/// plane levels: round((8 + 1.3 log2 N) / 3), 10 up to about 100k primitives and 13 at 10M.
+inline int auto_octree_depth_limit(size_t n) {
+  return int(std::lround((8.0 + 1.3 * std::log2(double(std::max<size_t>(n, 1)))) / 3.0));
+}
+
 }  // namespace ab

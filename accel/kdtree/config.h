@@ -21,6 +21,10 @@ struct KdMedianConfig {
       0.75;           ///< a node whose split would put more than this share on both sides is a leaf
   int max_depth = 0;  ///< depth limit; 0: auto_depth_limit of the primitive count
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
+  int bad_refines = 3;  ///< a node whose split is the bad_refines-th bad one on its path is a leaf (pbrt-v3)
+  /// pbrt-v3's cost model of the bad-refine rule (KdTreeAccel: traversalCost 1, isectCost 80).
+  SahCosts costs{.traversal = 1.0f, .intersection = 80.0f, .empty_bonus = 0.0f};
+  double ref_budget = 64.0;  ///< the leaves hold at most this many references per primitive (RefBudget)
 
   /// Reads every field from params.
   static KdMedianConfig read(Params& params) {
@@ -30,6 +34,10 @@ struct KdMedianConfig {
     params.read("straddle_limit", c.straddle_limit, 0.0, 1.0);
     params.read("max_depth", c.max_depth, 0, 100);
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
+    params.read("bad_refines", c.bad_refines, 0, 1000);
+    params.read("traversal_cost", c.costs.traversal, 1e-3, 1e6);
+    params.read("intersection_cost", c.costs.intersection, 1e-3, 1e6);
+    params.read("ref_budget", c.ref_budget, 1.0, 1e6);
     return c;
   }
 };

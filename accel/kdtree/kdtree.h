@@ -88,7 +88,9 @@ class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
       if constexpr (M == KdMethod::kSah) {
         KdSahBuilder<P>(*prims_, config_, depth_limit).build(ids, box_, out);
       } else {
-        KdMedianBuilder<P>(*prims_, config_, depth_limit).build(ids, box_, out);
+        KdMedianBuilder<P> builder(*prims_, config_, depth_limit);
+        builder.build(ids, box_, out);
+        this->stats_.extra["budget_exhausted"] = builder.budget_exhausted();
       }
     }
     drop_empty_leaves(out.nodes);

@@ -4,6 +4,11 @@
 // of them would straddle the plane (then splitting mostly duplicates them). Primitives are tracked by
 // their perfect-split bounds inside the node box, and the partition is conservative: a primitive that
 // touches the plane or comes within the insertion margin of it goes to both children.
+// Two more rules bound the references on any input (large overlapping triangles, fans):
+// - pbrt-v3's bad refines (Pharr, Jakob and Humphreys 2016, 4.4.2): a split is bad when its surface-area
+//   cost estimate Ct + Ci (pL nL + pR nR) is not below the leaf's Ci n; the bad_refines-th bad split on a
+//   path makes a leaf instead;
+// - the reference budget (refine_rules.h) as a safety net: at most ref_budget references per primitive.
 #pragma once
 
 #include <tbb/parallel_invoke.h>
@@ -12,6 +17,7 @@
 #include <vector>
 
 #include "accel/common/conservative_insertion.h"
+#include "accel/common/refine_rules.h"
 #include "accel/kdtree/config.h"
 #include "accel/kdtree/node.h"
 
@@ -35,12 +41,38 @@ class KdMedianBuilder {
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
     std::vector<Ref> refs(ids.size());
     for (size_t i = 0; i < ids.size(); ++i) refs[i] = {ids[i], prims_.clipped_bounds(ids[i], box)};
-    build_node(std::move(refs), box, 0, out);
+    build_node(std::move(refs), box, {0, 0, {config_.ref_budget * double(ids.size())}}, out);
   }
+  /// True when some node became a leaf for the reference budget.
+  bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
-  void build_node(std::vector<Ref>&& refs, const AABB& box, int depth, KdBuffer& out) const {
+  /// Where a node sits: its depth, the bad refines on its path, its reference budget.
+  struct Path {
+    int depth;
+    int bad;
+    RefBudget budget;
+  };
+
+  /// True when splitting a node (box, n primitives) into children (lbox, nl), (rbox, nr) should not be done.
+  bool stop(const AABB& box, size_t n, const AABB& lbox, size_t nl, const AABB& rbox, size_t nr,
+            Path& path) const {
+    if (double(nl + nr) > double(n) * (1.0 + config_.straddle_limit)) return true;  // no longer pays
+    const SahCosts& c = config_.costs;
+    const double area = box.area();
+    const double split =
+        c.traversal +
+        c.intersection *
+            (area > 0.0 ? (lbox.area() * double(nl) + rbox.area() * double(nr)) / area : double(nl + nr));
+    if (too_many_bad_refines(split >= c.intersection * double(n), config_.bad_refines, path.bad)) return true;
+    if (path.budget.allows(nl + nr)) return false;
+    budget_exhausted_ = true;
+    return true;
+  }
+
+  void build_node(std::vector<Ref>&& refs, const AABB& box, Path path, KdBuffer& out) const {
     const size_t n = refs.size();
+    const int depth = path.depth;
     int axis = config_.axis == KdAxisRule::kCycle ? depth % 3 : box.longest_axis();
     float split = 0.0f;
     if (n <= config_.leaf_size || depth >= depth_limit_ || !median_plane(refs, box, axis, split)) {
@@ -52,24 +84,27 @@ class KdMedianBuilder {
     lbox.hi[axis] = split;
     rbox.lo[axis] = split;
     partition(refs, axis, split, insertion_margin(box), lbox, rbox, left, right);
-    if (double(left.size() + right.size()) > double(n) * (1.0 + config_.straddle_limit)) {  // no longer pays
+    if (stop(box, n, lbox, left.size(), rbox, right.size(), path)) {
       make_leaf(refs, out);
       return;
     }
     std::vector<Ref>().swap(refs);
+    const size_t all = left.size() + right.size();
+    const Path lp{depth + 1, path.bad, path.budget.share(left.size(), all)};
+    const Path rp{depth + 1, path.bad, path.budget.share(right.size(), all)};
     const size_t self = out.nodes.size();
     out.nodes.push_back(KdNode::leaf(0, 0));
     if (n >= kParallelMin) {
       KdBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lbox, depth + 1, lb); },
-                           [&] { build_node(std::move(right), rbox, depth + 1, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lbox, lp, lb); },
+                           [&] { build_node(std::move(right), rbox, rp, rb); });
       out.append(lb);
       out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lbox, depth + 1, out);
+      build_node(std::move(left), lbox, lp, out);
       out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rbox, depth + 1, out);
+      build_node(std::move(right), rbox, rp, out);
     }
   }
 
@@ -111,6 +146,7 @@ class KdMedianBuilder {
   const P& prims_;
   KdMedianConfig config_;
   int depth_limit_;
+  mutable BudgetFlag budget_exhausted_{false};
 };
 
 }  // namespace ab

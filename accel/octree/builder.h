@@ -1,9 +1,17 @@
 // The adaptive octree build: a cube around the scene, subdivided into eight equal children while a node
-// holds more than leaf_size primitives and is above the depth limit. Primitives are inserted by exact
-// primitive/box overlap against the child boxes grown by the insertion margin (inflate_for_insertion,
-// clip.h), so a primitive touching a cell or within rounding of its boundary is in every such cell. Large
-// nodes build their eight subtrees in parallel, each into its own buffer, spliced in child order (the same
-// tree for any thread count).
+// holds more than leaf_size primitives and is above the depth limit, and the subdivision still pays:
+// - the depth limit grows with log N (auto_octree_depth_limit, Havran 2000's 8 + 1.3 log2 N in octree
+//   levels), never below max_depth;
+// - pbrt-v3's bad refines (Pharr, Jakob and Humphreys 2016, 4.4.2): a subdivision is bad when its
+//   estimated cost is not below the leaf's; with the surface-area estimate, each child cube has a quarter
+//   of its parent's area, so it is bad when the children hold at least 4x the node's references; the
+//   bad_refines-th bad one on a path makes a leaf instead (large overlapping triangles, copied into most
+//   children, stop after a few levels);
+// - the reference budget (refine_rules.h) as a safety net: at most ref_budget references per primitive.
+// Primitives are inserted by exact primitive/box overlap against the child boxes grown by the insertion
+// margin (inflate_for_insertion, clip.h), so a primitive touching a cell or within rounding of its boundary
+// is in every such cell. Large nodes build their eight subtrees in parallel, each into its own buffer,
+// spliced in child order (the same tree for any thread count).
 #pragma once
 
 #include <tbb/parallel_for.h>
@@ -13,6 +21,7 @@
 #include <cmath>
 #include <vector>
 
+#include "accel/common/refine_rules.h"
 #include "accel/core/clip.h"
 #include "accel/octree/config.h"
 #include "accel/octree/node.h"
@@ -41,40 +50,66 @@ template <class P>
 class OctreeBuilder {
  public:
   /// Builder over prims with the tree's configuration.
-  OctreeBuilder(const P& prims, const OctreeConfig& config) : prims_(prims), config_(config) {}
+  OctreeBuilder(const P& prims, const OctreeConfig& config, int depth_limit)
+      : prims_(prims), config_(config), depth_limit_(depth_limit) {}
 
   /// Builds the tree over the primitives ids (finite bounds) inside the cube `box` into out (root: node 0).
   void build(std::vector<uint32_t>&& ids, const AABB& box, OctBuffer& out) const {
     out.nodes.push_back(OctNode::leaf(0, 0));
-    if (!ids.empty()) build_node(std::move(ids), box, 0, 0, out);
+    const RefBudget budget{config_.ref_budget * double(ids.size())};
+    if (!ids.empty()) build_node(std::move(ids), box, {0, 0, budget}, 0, out);
   }
+  /// True when some node became a leaf for the reference budget.
+  bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
+  /// Where a node sits: its depth, the bad refines on its path, its reference budget.
+  struct Path {
+    int depth;
+    int bad;
+    RefBudget budget;
+  };
+
+  /// True when the eight children `kids` of a node of n primitives should not be made (a leaf instead).
+  bool stop(const std::array<std::vector<uint32_t>, 8>& kids, size_t n, Path& path) const {
+    bool progress = false;
+    size_t refs = 0;
+    for (const auto& k : kids) {
+      progress |= !k.empty() && k.size() < n;
+      refs += k.size();
+    }
+    if (!progress || too_many_bad_refines(refs >= 4 * n, config_.bad_refines, path.bad)) return true;
+    if (path.budget.allows(refs)) return false;
+    budget_exhausted_ = true;
+    return true;
+  }
+
   /// Builds node `self` (already allocated) over ids inside box.
-  void build_node(std::vector<uint32_t>&& ids, const AABB& box, int depth, uint32_t self,
+  void build_node(std::vector<uint32_t>&& ids, const AABB& box, Path path, uint32_t self,
                   OctBuffer& out) const {
     std::array<std::vector<uint32_t>, 8> kids;
-    if (ids.size() > config_.leaf_size && depth < config_.max_depth) distribute(ids, box, kids);
-    bool progress = false;
-    for (const auto& k : kids) progress |= !k.empty() && k.size() < ids.size();
-    if (!progress) {
+    if (ids.size() > config_.leaf_size && path.depth < depth_limit_) distribute(ids, box, kids);
+    if (stop(kids, ids.size(), path)) {
       out.nodes[self] = out.make_leaf(ids);
       return;
     }
+    size_t refs = 0;
+    for (const auto& k : kids) refs += k.size();
+    std::array<Path, 8> sub;
+    for (int k = 0; k < 8; ++k) sub[k] = {path.depth + 1, path.bad, path.budget.share(kids[k].size(), refs)};
     const size_t n = ids.size();
     std::vector<uint32_t>().swap(ids);
     const uint32_t first = uint32_t(out.nodes.size());
     out.nodes[self] = OctNode::interior(first);
     out.nodes.resize(first + 8, OctNode::leaf(0, 0));
     if (n < kParallelMin) {
-      for (int k = 0; k < 8; ++k)
-        build_node(std::move(kids[k]), octant_box(box, k), depth + 1, first + k, out);
+      for (int k = 0; k < 8; ++k) build_node(std::move(kids[k]), octant_box(box, k), sub[k], first + k, out);
       return;
     }
     std::array<OctBuffer, 8> subs;
     tbb::parallel_for(0, 8, [&](int k) {
       subs[k].nodes.push_back(OctNode::leaf(0, 0));
-      build_node(std::move(kids[k]), octant_box(box, k), depth + 1, 0, subs[k]);
+      build_node(std::move(kids[k]), octant_box(box, k), sub[k], 0, subs[k]);
     });
     for (int k = 0; k < 8; ++k) out.splice(subs[k], first + k);
   }
@@ -93,6 +128,8 @@ class OctreeBuilder {
   static constexpr size_t kParallelMin = 20000;
   const P& prims_;
   OctreeConfig config_;
+  int depth_limit_;
+  mutable BudgetFlag budget_exhausted_{false};
 };
 
 }  // namespace ab

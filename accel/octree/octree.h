@@ -9,10 +9,12 @@
 // its entry lies strictly beyond the best hit so far.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
 #include "accel/common/conservative_insertion.h"
+#include "accel/common/depth_limit.h"
 #include "accel/common/finite_primitives.h"
 #include "accel/common/leaf_refs.h"
 #include "accel/common/spatial_tree_queries.h"
@@ -74,10 +76,17 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
     std::vector<uint32_t> ids = partition_finite(*prims_, unbounded_, box);
     box_ = cube_around(box);
     margin_ = box_.empty() ? 0.0f : insertion_margin(box_);
+    const int depth_limit =
+        config_.auto_depth
+            ? std::min(Config::kMaxDepth, std::max(config_.max_depth, auto_octree_depth_limit(ids.size())))
+            : config_.max_depth;
     OctBuffer out;
-    OctreeBuilder<P>(*prims_, config_).build(std::move(ids), box_, out);
+    OctreeBuilder<P> builder(*prims_, config_, depth_limit);
+    builder.build(std::move(ids), box_, out);
     nodes_ = std::move(out.nodes);
     leaves_.assign(*prims_, std::move(out.refs), config_.leaf_copies);
+    this->stats_.extra["depth_limit"] = depth_limit;
+    this->stats_.extra["budget_exhausted"] = builder.budget_exhausted();
   }
 
   void gather_stats(BuildStats& stats) const override {
