@@ -51,7 +51,7 @@ TEST(Termination, HostileInputsKeepReferencesBounded) {
 }
 
 TEST(Termination, BudgetIsASafetyNetReportedInTheStatistics) {
-  const Mesh hostile = generate_mesh("large", 3000, 2, Params());
+  const Mesh hostile = generate_mesh("mixed", 3000, 2, Params());
   const Mesh tame = random_soup(3000, 4, 0.01f);
   for (const char* name : kBounded) {
     const std::map<std::string, std::string> tight{{"ref_budget", "1.5"}, {"bad_refines", "0"}};
@@ -63,8 +63,8 @@ TEST(Termination, BudgetIsASafetyNetReportedInTheStatistics) {
   }
 }
 
-TEST(Termination, BadRefinesStopLargeOverlappingTriangles) {
-  const Mesh mesh = generate_mesh("large", 3000, 5, Params());
+TEST(Termination, BadRefinesStopLargeTrianglesAmongDegenerateOnes) {
+  const Mesh mesh = generate_mesh("mixed", 3000, 5, Params());
   for (const char* name : kBounded) {
     const std::map<std::string, std::string> off{{"bad_refines", "0"}, {"ref_budget", "1000"}};
     const uint64_t with = built(name, mesh)->stats().references;
