@@ -105,6 +105,41 @@ TEST(Gltf, AFramesHitsAreIdenticalAcrossStructures) {
   }
 }
 
+/// Appends `bytes` of p to the model's one buffer as a new view and an accessor over it; its index.
+int add_accessor(tinygltf::Model& m, const void* p, size_t bytes, int type, int comp, size_t count) {
+  auto& buf = m.buffers[0].data;
+  tinygltf::BufferView bv;
+  bv.buffer = 0;
+  bv.byteOffset = buf.size();
+  bv.byteLength = bytes;
+  buf.insert(buf.end(), (const unsigned char*)p, (const unsigned char*)p + bytes);
+  while (buf.size() % 4) buf.push_back(0);
+  m.bufferViews.push_back(bv);
+  tinygltf::Accessor a;
+  a.bufferView = int(m.bufferViews.size() - 1);
+  a.type = type;
+  a.componentType = comp;
+  a.count = count;
+  m.accessors.push_back(a);
+  return int(m.accessors.size() - 1);
+}
+
+/// Animates node 0's translation with a STEP sampler over the accessors `times` and `moves`.
+void add_step_translation(tinygltf::Model& m, int times, int moves) {
+  tinygltf::Animation an;
+  tinygltf::AnimationSampler s;
+  s.input = times;
+  s.output = moves;
+  s.interpolation = "STEP";
+  an.samplers = {s};
+  tinygltf::AnimationChannel c;
+  c.sampler = 0;
+  c.target_node = 0;
+  c.target_path = "translation";
+  an.channels = {c};
+  m.animations = {an};
+}
+
 /// A small model: one quad (strip) and one triangle (list) in one mesh, a parent node with a child.
 tinygltf::Model small_model() {
   tinygltf::Model m;
@@ -115,33 +150,18 @@ tinygltf::Model small_model() {
   const uint32_t list[] = {0, 1, 2};
   const float times[] = {0.0f, 2.0f};
   const float moves[] = {0, 0, -5, 4, 0, -5};  // replaces the parent's static translation
-  auto& buf = m.buffers[0].data;
-  const auto add = [&](const void* p, size_t bytes, int type, int comp, size_t count) {
-    tinygltf::BufferView bv;
-    bv.buffer = 0;
-    bv.byteOffset = buf.size();
-    bv.byteLength = bytes;
-    buf.insert(buf.end(), (const unsigned char*)p, (const unsigned char*)p + bytes);
-    while (buf.size() % 4) buf.push_back(0);
-    m.bufferViews.push_back(bv);
-    tinygltf::Accessor a;
-    a.bufferView = int(m.bufferViews.size() - 1);
-    a.type = type;
-    a.componentType = comp;
-    a.count = count;
-    m.accessors.push_back(a);
-    return int(m.accessors.size() - 1);
-  };
-  const int apos = add(pos, sizeof pos, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT, 4);
+  const int apos = add_accessor(m, pos, sizeof pos, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT, 4);
   m.accessors[size_t(apos)].minValues = {0, 0, 0};
   m.accessors[size_t(apos)].maxValues = {1, 1, 0};
   const int astrip =
-      add(strip, sizeof strip, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, 4);
-  const int alist = add(list, sizeof list, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, 3);
-  const int at = add(times, sizeof times, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_FLOAT, 2);
+      add_accessor(m, strip, sizeof strip, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, 4);
+  const int alist =
+      add_accessor(m, list, sizeof list, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, 3);
+  const int at = add_accessor(m, times, sizeof times, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_FLOAT, 2);
   m.accessors[size_t(at)].minValues = {0};
   m.accessors[size_t(at)].maxValues = {2};
-  const int amove = add(moves, sizeof moves, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT, 2);
+  const int amove =
+      add_accessor(m, moves, sizeof moves, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT, 2);
   tinygltf::Mesh mesh;
   tinygltf::Primitive p;
   p.attributes["POSITION"] = apos;
@@ -162,18 +182,7 @@ tinygltf::Model small_model() {
   m.scenes.resize(1);
   m.scenes[0].nodes = {0};
   m.defaultScene = 0;
-  tinygltf::Animation an;
-  tinygltf::AnimationSampler s;
-  s.input = at;
-  s.output = amove;
-  s.interpolation = "STEP";
-  an.samplers = {s};
-  tinygltf::AnimationChannel c;
-  c.sampler = 0;
-  c.target_node = 0;
-  c.target_path = "translation";
-  an.channels = {c};
-  m.animations = {an};
+  add_step_translation(m, at, amove);
   return m;
 }
 
