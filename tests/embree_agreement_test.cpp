@@ -29,7 +29,9 @@ TEST(EmbreeAgreement, BruteAgreesWithEmbreeOnEveryGeneratorAndRayKind) {
       const Agreement a = classify_agreement(rays, ours, theirs, hit_triangles(target));
       EXPECT_EQ(a.unexplained, 0u) << gen.name << " / " << kind.name << ": first unexplained ray "
                                    << (a.unexplained_rays.empty() ? 0 : a.unexplained_rays.front());
-      EXPECT_GT(a.agree, rays.size() * 9 / 10) << gen.name << " / " << kind.name;
+      // Ties count with agreement: on a stack of coplanar overlapping triangles (the coplanar generator)
+      // most hits are ties by construction, where each side may name a different triangle at the same t.
+      EXPECT_GT(a.agree + a.tie, rays.size() * 9 / 10) << gen.name << " / " << kind.name;
       size_t found = 0;
       for (const Hit& h : ours) found += h.found();
       if (kind.name == "primary") {

@@ -119,9 +119,9 @@ TEST(Generators, CityscapeHasLatticeCoordinatesDuplicatesAndDegenerates) {
   }
 }
 
-TEST(Generators, OnlyCityscapeHasZeroAreaTriangles) {
+TEST(Generators, OnlyCityscapeAndMixedHaveZeroAreaTriangles) {
   for (const GeneratorInfo& g : generators()) {
-    if (g.name == "cityscape") continue;
+    if (g.name == "cityscape" || g.name == "mixed") continue;  // degenerate triangles by design
     const Mesh m = generate_mesh(g.name, 20000, 3, Params());
     size_t zero_area = 0;
     for (size_t i = 0; i < m.size(); ++i) {
