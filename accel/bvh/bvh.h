@@ -32,6 +32,9 @@
 
 namespace ab {
 
+template <class B>
+struct BvhRefit;
+
 /// A BVH over primitive set P built by the builder of its Config C (BvhMedianConfig, BvhSahConfig or
 /// BvhSweepConfig). For triangles the vertices are copied into leaf order for locality (blocks of four for
 /// width 8); hits still carry the original ids.
@@ -108,6 +111,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   }
 
  protected:
+  /// Refit hooks (refit.h, Wald, Boulos and Shirley 2007).
+  bool do_refit_triangles(std::shared_ptr<const TrianglePrims> p) override {
+    return BvhRefit<Bvh>::refit(*this, p);
+  }
+  bool do_refit_instances(std::shared_ptr<const InstancePrims> p) override {
+    return BvhRefit<Bvh>::refit(*this, p);
+  }
+
   void do_build() override {
     BvhBuildResult result = build_bvh_over_prims();
     nodes_ = std::move(result.nodes);
@@ -145,6 +156,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   }
 
  private:
+  friend struct BvhRefit<Bvh>;
   static constexpr bool kCopiesTriangles = std::is_same_v<P, TrianglePrims>;
 
   /// What a wide leaf is tested with: the ray broadcast to four lanes for triangle blocks, else the ray.
@@ -255,3 +267,5 @@ template <class P>
 using BvhSweep = Bvh<P, BvhSweepConfig>;
 
 }  // namespace ab
+
+#include "accel/bvh/refit.h"  // the refit the hooks above call (it needs Bvh complete)

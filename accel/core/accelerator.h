@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -14,6 +15,9 @@
 #include "accel/core/stats.h"
 
 namespace ab {
+
+class TrianglePrims;
+class InstancePrims;
 
 /// An acceleration structure over one primitive set.
 class Accelerator {
@@ -28,6 +32,17 @@ class Accelerator {
     do_build();
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     gather_stats(stats_);
+  }
+
+  /// Moves the structure to new positions of its primitives (the same count and ids) by refitting over the
+  /// unchanged topology (accel/bvh/refit.h). False, with nothing changed, when the structure does not refit;
+  /// on success stats() describe the refitted structure and build_seconds is the refit's wall time.
+  bool refit(std::shared_ptr<const TrianglePrims> geometry) {
+    return timed_refit([&] { return do_refit_triangles(std::move(geometry)); });
+  }
+  /// The same for a top level over instances that moved (their bottom levels already updated).
+  bool refit(std::shared_ptr<const InstancePrims> instances) {
+    return timed_refit([&] { return do_refit_instances(std::move(instances)); });
   }
 
   /// Registry name (for example "bvh-sah"), as the registry recorded it (identify()).
@@ -70,9 +85,25 @@ class Accelerator {
   /// Fills the statistics of the finished structure (not timed): most structures describe their tree to
   /// the one statistics walk (accel/common/tree_stats.h) and add their bytes.
   virtual void gather_stats(BuildStats& stats) const { (void)stats; }
+  /// The refit over moved triangles (refit()); false when unsupported.
+  virtual bool do_refit_triangles(std::shared_ptr<const TrianglePrims>) { return false; }
+  /// The refit over moved instances (refit()); false when unsupported.
+  virtual bool do_refit_instances(std::shared_ptr<const InstancePrims>) { return false; }
   BuildStats stats_;
 
  private:
+  /// Runs a refit, timing it alone as build() does; the statistics are gathered again on success.
+  template <class F>
+  bool timed_refit(F&& f) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!f()) return false;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats_ = BuildStats{};
+    stats_.build_seconds = seconds;
+    gather_stats(stats_);
+    return true;
+  }
+
   std::string name_;
   nlohmann::json config_ = nlohmann::json::object();
 };
