@@ -1,5 +1,7 @@
 #include "accel/reference/embree.h"
 
+#include <cstring>
+
 #include "accel/core/registry.h"
 
 namespace ab {
@@ -16,8 +18,35 @@ void EmbreeMesh::do_build() {
   scene_ = nullptr;
   const int64_t bytes_before = embree_bytes_in_use();
   scene_ = commit_mesh_scene(prims_->mesh(), config_.quality, RTC_SCENE_FLAG_NONE);
+  dynamic_ = false;
   const int64_t grown = embree_bytes_in_use() - bytes_before;
   stats_.bytes = grown > 0 ? static_cast<uint64_t>(grown) : 0;
+}
+
+void EmbreeMesh::commit_frame(std::shared_ptr<const TrianglePrims> prims, RTCBuildQuality quality) {
+  const size_t old_vertices = prims_->mesh().vertices.size();
+  prims_ = std::move(prims);
+  const Mesh& mesh = prims_->mesh();
+  if (!dynamic_ || quality != geometry_quality_ || mesh.vertices.size() != old_vertices || mesh.size() == 0) {
+    if (scene_) rtcReleaseScene(scene_);
+    scene_ = commit_mesh_scene(mesh, config_.quality, RTC_SCENE_FLAG_DYNAMIC, quality);
+    dynamic_ = true;
+    geometry_quality_ = quality;
+    return;
+  }
+  RTCGeometry geom = rtcGetGeometry(scene_, 0);
+  auto* vertices = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+  std::memcpy(vertices, mesh.vertices.data(), sizeof(float) * 3 * mesh.vertices.size());
+  rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+  rtcCommitGeometry(geom);
+  rtcCommitScene(scene_);
+  check_embree_error("dynamic commit");
+}
+
+bool EmbreeMesh::do_refit_triangles(std::shared_ptr<const TrianglePrims> prims) {
+  if (!prims || prims->size() != prims_->size()) return false;
+  commit_frame(std::move(prims), RTC_BUILD_QUALITY_REFIT);
+  return true;
 }
 
 void EmbreeMesh::gather_stats(BuildStats& stats) const {

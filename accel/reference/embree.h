@@ -35,6 +35,12 @@ class EmbreeMesh final : public Accelerator {
   void intersect_one(const Ray& ray, Hit& best, uint32_t inst, RayCounters* counters) const override;
   bool occluded_one(const Ray& ray, RayCounters* counters) const override;
 
+  /// Moves the mesh to `prims` (the same triangles, new vertex positions) and commits it again in a dynamic
+  /// scene (RTC_SCENE_FLAG_DYNAMIC) whose geometry has build quality `quality`: RTC_BUILD_QUALITY_REFIT
+  /// refits Embree's BVH, low or medium rebuild it. The first call (or a change of quality or vertex count)
+  /// makes the dynamic scene; later calls update the vertex buffer in place. Not timed here.
+  void commit_frame(std::shared_ptr<const TrianglePrims> prims, RTCBuildQuality quality);
+
   /// The committed Embree scene (for adapters that instance it).
   RTCScene scene() const { return scene_; }
 
@@ -42,11 +48,15 @@ class EmbreeMesh final : public Accelerator {
   /// Uploads the mesh and commits the scene; records the bytes Embree's memory monitor saw it take.
   void do_build() override;
   void gather_stats(BuildStats& stats) const override;
+  /// commit_frame at RTC_BUILD_QUALITY_REFIT.
+  bool do_refit_triangles(std::shared_ptr<const TrianglePrims> prims) override;
 
  private:
   std::shared_ptr<const TrianglePrims> prims_;
   Config config_;
   RTCScene scene_ = nullptr;
+  bool dynamic_ = false;                                         ///< scene_ is commit_frame's dynamic scene
+  RTCBuildQuality geometry_quality_ = RTC_BUILD_QUALITY_MEDIUM;  ///< its geometry's quality
 };
 
 }  // namespace ab

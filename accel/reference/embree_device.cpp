@@ -46,13 +46,18 @@ void check_embree_error(const char* what) {
 }
 
 RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags) {
+  return commit_mesh_scene(mesh, quality, flags, quality);
+}
+
+RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags,
+                           RTCBuildQuality geometry_quality) {
   RTCDevice device = embree_device();
   RTCScene scene = rtcNewScene(device);
   rtcSetSceneFlags(scene, flags);
   rtcSetSceneBuildQuality(scene, quality);
   if (mesh.size() > 0) {
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(geom, quality);
+    rtcSetGeometryBuildQuality(geom, geometry_quality);
     // Embree reads vertex buffers with 16-byte loads: allocated through it, the buffer is padded for that.
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
         geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, mesh.vertices.size()));

@@ -33,6 +33,10 @@ struct EmbreeConfig {
 /// A committed Embree scene holding `mesh` as geometry 0 (primID = triangle id; no geometry when the mesh is
 /// empty), built at `quality` with `flags`. Throws InputError when Embree reports an error.
 RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags);
+/// The same with the geometry's build quality apart from the scene's (RTC_BUILD_QUALITY_REFIT for a mesh
+/// that is refitted when its vertices move).
+RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags,
+                           RTCBuildQuality geometry_quality);
 
 /// Throws InputError naming `what` when the device has recorded an error (and clears it).
 void check_embree_error(const char* what);
