@@ -46,14 +46,18 @@ nlohmann::json SceneAccelerator::config() const {
 
 void SceneAccelerator::do_build() {
   for (auto& b : bottoms_) b->build();
+  instances_ = std::make_shared<InstancePrims>(make_instances());
+  top_ = make_instance_accelerator(top_name_, instances_, top_params_);
+  top_->build();
+  aggregate_stats();
+}
+
+std::vector<Instance> SceneAccelerator::make_instances() const {
   std::vector<Instance> instances;
   instances.reserve(scene_->instances.size());
   for (const SceneInstance& si : scene_->instances)
     instances.push_back({bottoms_[si.mesh], si.transform.to_world, si.transform.to_object, si.mesh});
-  instances_ = std::make_shared<InstancePrims>(std::move(instances));
-  top_ = make_instance_accelerator(top_name_, instances_, top_params_);
-  top_->build();
-  aggregate_stats();
+  return instances;
 }
 
 // Both levels in one set of figures: nodes, leaves and bytes are sums (each bottom counted once,

@@ -46,6 +46,15 @@ class SceneAccelerator final : public Accelerator {
     return top_->occluded_one(ray, counters);
   }
 
+  /// How one level follows a frame in update().
+  enum class LevelUpdate { kRefit, kRebuild };
+  /// Moves the built structure to `frame` (the same scene at another time: same meshes, triangle lists and
+  /// instances): each base mesh whose geometry changed is refit or rebuilt as `bottom` says (unchanged ones
+  /// are kept), then the top level over the new transforms as `top` says. Timed alone into
+  /// stats().build_seconds (tracer/update_strategy.cpp). False when a level does not refit or the frame does
+  /// not match; the structure must then be rebuilt.
+  bool update(std::shared_ptr<const Scene> frame, LevelUpdate bottom, LevelUpdate top);
+
   /// The built bottom-level structure of base mesh m.
   const Accelerator& bottom(size_t m) const { return *bottoms_[m]; }
   /// The built top-level structure.
@@ -56,6 +65,8 @@ class SceneAccelerator final : public Accelerator {
 
  private:
   void aggregate_stats();
+  /// The instances of scene_ over the current bottoms.
+  std::vector<Instance> make_instances() const;
 
   std::shared_ptr<const Scene> scene_;
   std::string top_name_, bottom_name_;

@@ -1,0 +1,156 @@
+#include "tracer/update_strategy.h"
+
+#include <chrono>
+
+#include "accel/core/error.h"
+#include "accel/core/primitives.h"
+#include "accel/core/registry.h"
+#include "tracer/scene_accel.h"
+
+namespace ab {
+
+namespace {
+
+/// The comparable SAH cost of one structure's own figures (see update_sah_cost).
+double own_sah_cost(const nlohmann::json& stats) {
+  const nlohmann::json& extra = stats.contains("extra") ? stats["extra"] : nlohmann::json::object();
+  if (extra.contains("wide_sah_cost")) return extra["wide_sah_cost"].get<double>();
+  return stats.value("sah_cost", 0.0);
+}
+
+/// A one-triangle scene with one instance (the probe of supports()).
+std::shared_ptr<const Scene> probe_scene() {
+  auto mesh = std::make_shared<Mesh>();
+  mesh->vertices = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}};
+  mesh->triangles = {{0u, 1u, 2u}};
+  auto scene = std::make_shared<Scene>();
+  SceneMesh m;
+  m.name = "probe";
+  m.mesh = mesh;
+  m.base = mesh;
+  scene->meshes.push_back(m);
+  scene->instances.emplace_back();
+  scene->bounds = scene->compute_world_bounds();
+  return scene;
+}
+
+}  // namespace
+
+const std::vector<UpdateStrategy>& all_update_strategies() {
+  static const std::vector<UpdateStrategy> all{UpdateStrategy::kRebuild, UpdateStrategy::kRefit,
+                                               UpdateStrategy::kAdaptive, UpdateStrategy::kTopLevel};
+  return all;
+}
+
+std::string strategy_name(UpdateStrategy strategy) {
+  switch (strategy) {
+    case UpdateStrategy::kRebuild:
+      return "rebuild";
+    case UpdateStrategy::kRefit:
+      return "refit";
+    case UpdateStrategy::kAdaptive:
+      return "adaptive";
+    case UpdateStrategy::kTopLevel:
+      return "top-level";
+  }
+  return "rebuild";
+}
+
+UpdateStrategy parse_strategy(const std::string& name) {
+  for (UpdateStrategy s : all_update_strategies())
+    if (strategy_name(s) == name) return s;
+  throw ParamError("strategy '" + name + "' is not one of rebuild, refit, adaptive, top-level");
+}
+
+double update_sah_cost(const Accelerator& accel) {
+  const nlohmann::json stats = to_json(accel.stats());
+  const nlohmann::json& extra = stats["extra"];
+  if (!extra.contains("top") || !extra.contains("bottoms")) return own_sah_cost(stats);
+  double cost = own_sah_cost(extra["top"]);
+  for (const nlohmann::json& b : extra["bottoms"]) cost += own_sah_cost(b);
+  return cost;
+}
+
+FrameUpdater::FrameUpdater(std::string name, Params params, UpdateStrategy strategy, double threshold)
+    : name_(std::move(name)), params_(std::move(params)), strategy_(strategy), threshold_(threshold) {}
+
+bool FrameUpdater::supports(const std::string& name, const Params& params, UpdateStrategy strategy) {
+  if (strategy == UpdateStrategy::kRebuild) return true;
+  auto scene = probe_scene();
+  std::unique_ptr<Accelerator> accel;
+  try {
+    accel = make_scene_accelerator(scene, name, params);
+  } catch (const std::exception&) {
+    return false;  // not a structure of scenes (the rebuild strategy reports the error)
+  }
+  auto* two_level = dynamic_cast<SceneAccelerator*>(accel.get());
+  if (!two_level) return false;  // Embree's own instancing: rebuilt every frame only
+  if (strategy == UpdateStrategy::kTopLevel) return true;
+  accel->build();
+  auto moved = std::make_shared<Scene>(*scene);
+  moved->meshes[0].mesh = std::make_shared<Mesh>(*scene->meshes[0].mesh);
+  return two_level->update(moved, SceneAccelerator::LevelUpdate::kRefit,
+                           SceneAccelerator::LevelUpdate::kRefit);
+}
+
+FrameUpdate FrameUpdater::update(std::shared_ptr<const Scene> frame) {
+  if (!accel_ || strategy_ == UpdateStrategy::kRebuild) return rebuild(std::move(frame));
+  if (strategy_ == UpdateStrategy::kTopLevel) return refit(std::move(frame), true);
+  if (strategy_ == UpdateStrategy::kAdaptive && rebuilt_cost_ > 0.0 &&
+      last_cost_ > threshold_ * rebuilt_cost_)
+    return rebuild(std::move(frame));
+  return refit(std::move(frame), false);
+}
+
+FrameUpdate FrameUpdater::rebuild(std::shared_ptr<const Scene> frame) {
+  accel_ = make_scene_accelerator(std::move(frame), name_, params_);
+  accel_->build();
+  FrameUpdate out{accel_->stats().build_seconds, update_sah_cost(*accel_), true};
+  rebuilt_cost_ = last_cost_ = out.sah_cost;
+  ++rebuilds_;
+  return out;
+}
+
+FrameUpdate FrameUpdater::refit(std::shared_ptr<const Scene> frame, bool top_only) {
+  auto* two_level = dynamic_cast<SceneAccelerator*>(accel_.get());
+  using L = SceneAccelerator::LevelUpdate;
+  const L level = top_only ? L::kRebuild : L::kRefit;
+  if (!two_level || !two_level->update(std::move(frame), level, level))
+    throw InputError(name_ + ": cannot follow the frame by " + strategy_name(strategy_));
+  FrameUpdate out{accel_->stats().build_seconds, update_sah_cost(*accel_), false};
+  last_cost_ = out.sah_cost;
+  return out;
+}
+
+// SceneAccelerator::update lives here with the strategies that call it (scene_accel.cpp builds).
+bool SceneAccelerator::update(std::shared_ptr<const Scene> frame, LevelUpdate bottom, LevelUpdate top) {
+  if (!top_ || frame->meshes.size() != scene_->meshes.size() ||
+      frame->instances.size() != scene_->instances.size())
+    return false;
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t m = 0; m < bottoms_.size(); ++m) {
+    if (frame->meshes[m].mesh == scene_->meshes[m].mesh) continue;  // the same geometry: kept
+    if (frame->meshes[m].mesh->size() != scene_->meshes[m].mesh->size()) return false;
+    auto prims = std::make_shared<TrianglePrims>(frame->meshes[m].mesh);
+    if (bottom == LevelUpdate::kRefit) {
+      if (!bottoms_[m]->refit(prims)) return false;
+    } else {
+      bottoms_[m] = make_accelerator(bottom_name_, std::move(prims), bottom_params_);
+      bottoms_[m]->build();
+    }
+  }
+  scene_ = std::move(frame);
+  instances_ = std::make_shared<InstancePrims>(make_instances());
+  if (top == LevelUpdate::kRefit) {
+    if (!top_->refit(instances_)) return false;
+  } else {
+    top_ = make_instance_accelerator(top_name_, instances_, top_params_);
+    top_->build();
+  }
+  bounds_ = scene_->world_bounds();
+  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  aggregate_stats();
+  return true;
+}
+
+}  // namespace ab
