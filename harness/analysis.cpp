@@ -29,7 +29,7 @@ void fill_ratios(json& report) {
   std::map<std::string, double> embree;
   auto key = [](const json& r) {
     return r.value("scene", "") + "\n" + r.value("rays", "") + "\n" + r.value("query", "") + "\n" +
-           std::to_string(r.value("threads", -1));
+           std::to_string(r.value("threads", -1)) + "\n" + r.value("frame", json()).dump();
   };
   for (const json& r : report["results"])
     if (r.value("accelerator", "") == kEmbreeName && r.contains("rays_per_second") && !embree.count(key(r)))

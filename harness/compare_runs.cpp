@@ -72,13 +72,19 @@ std::vector<double> numbers(const json& j) {
 }
 
 /// The timed cases of a report, in its order: every query row, then every build.
+/// The scene of a row or build entry, with " frame N" for a frame of an animated scene (part of the case).
+std::string scene_of(const json& r) {
+  const std::string scene = r.value("scene", "");
+  return r.contains("frame") ? scene + " frame " + r["frame"].dump() : scene;
+}
+
 std::vector<std::pair<std::string, Sample>> cases_of(const json& report) {
   std::vector<std::pair<std::string, Sample>> out;
   for (const json& r : report["results"]) {
     const std::string query = r.value("query", "");
     if (query == "build" || !r.contains("seconds_median")) continue;
     Sample s;
-    s.id.scene = r.value("scene", "");
+    s.id.scene = scene_of(r);
     s.id.config = r.value("config_label", r.value("accelerator", ""));
     s.id.rays = r.value("rays", "");
     s.id.query = query;
@@ -90,7 +96,7 @@ std::vector<std::pair<std::string, Sample>> cases_of(const json& report) {
   for (const json& b : report.value("builds", json::array())) {
     if (!b.contains("build_seconds")) continue;
     Sample s;
-    s.id.scene = b.value("scene", "");
+    s.id.scene = scene_of(b);
     s.id.config = b.value("config_label", b.value("accelerator", ""));
     s.id.query = "build";
     s.id.threads = -1;

@@ -132,12 +132,14 @@ json in_scene_order(const std::vector<ShardRun>& shards, const char* list, const
   return out;
 }
 
-/// No case (scene, configuration, ray set, query, threads) twice in the merged results.
+/// No case (scene, configuration, ray set, query, threads, and frame for animated scenes) twice in the merged
+/// results.
 void check_unique_cases(const json& results) {
   std::set<std::string> seen;
   for (const json& r : results) {
     const std::string key = at(r, "/scene") + " / " + at(r, "/config_label") + " / " + at(r, "/rays") +
-                            " / " + at(r, "/query") + " / threads " + at(r, "/threads");
+                            " / " + at(r, "/query") + " / threads " + at(r, "/threads") +
+                            (r.contains("frame") ? " / frame " + at(r, "/frame") : "");
     if (!seen.insert(key).second) throw InputError("merge: case '" + key + "' appears twice");
   }
 }

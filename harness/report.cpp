@@ -65,7 +65,14 @@ const std::vector<std::string>& csv_columns() {
                                                 "embree_edge",
                                                 "embree_graze",
                                                 "embree_limit",
-                                                "embree_unexplained"};
+                                                "embree_unexplained",
+                                                "frame",
+                                                "strategy",
+                                                "update_seconds",
+                                                "rebuilt",
+                                                "update_sah_cost",
+                                                "sah_ratio_to_rebuild",
+                                                "frame_seconds"};
   return columns;
 }
 

@@ -1,19 +1,24 @@
 #include "harness/run.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "accel/core/trace.h"
 #include "datasets/atomic_file.h"
 #include "datasets/generators.h"
 #include "harness/analysis.h"
+#include "harness/frames.h"
 #include "harness/hitfile.h"
 #include "harness/report.h"
 #include "harness/report_rows.h"
 #include "harness/terminal.h"
 #include "harness/timing.h"
 #include "harness/verification.h"
+#include "tracer/scene.h"
+#include "tracer/update_strategy.h"
 
 namespace ab {
 
@@ -39,6 +44,16 @@ class Runner {
   }
   void save(bool finished = false);
   void run_scene(const SceneSpec& scene);
+  /// One configuration under one strategy across the frames of an animated scene.
+  struct FrameCase {
+    AccelSpec spec;  ///< the configuration, labelled "label:strategy"
+    std::string strategy;
+    std::unique_ptr<FrameUpdater> updater;
+  };
+  void run_animated_scene(const SceneSpec& scene);
+  std::vector<FrameCase> frame_cases(const SceneSpec& scene) const;
+  void run_frame(FrameCase& c, const Target& target, const SceneSpec& scene, uint64_t frame,
+                 std::vector<RaySet>& sets, std::map<std::string, double>& rebuild_cost);
   Target load(const SceneSpec& scene) const;
   std::vector<RaySet> make_ray_sets(const Target& target) const;
   std::unique_ptr<Accelerator> build(const Target& target, const std::string& scene, const AccelSpec& spec,
@@ -64,7 +79,11 @@ size_t Runner::count_units() const {
   size_t per_config = 1;
   if (!suite_.build_only)
     for (const auto& r : suite_.rays) per_config += 1 + suite_.threads.size() * (r.any_hit ? 2 : 1);
-  return suite_.scenes.size() * (1 + suite_.accelerators.size() * per_config);
+  size_t units = 0;
+  for (const SceneSpec& s : suite_.scenes)
+    units += std::max<size_t>(s.frames, 1) *
+             (1 + suite_.accelerators.size() * std::max<size_t>(s.strategies.size(), 1) * per_config);
+  return units;
 }
 
 bool Runner::stopping() {
@@ -82,6 +101,7 @@ void Runner::fail(const std::string& what) {
 
 void Runner::save(bool finished) {
   fill_ratios(report_);
+  fill_frame_summary(report_);
   fill_correlations(report_, suite_.threads.front());
   report_["interrupted"] = interrupted_;
   report_["complete"] = finished && !interrupted_;
@@ -134,6 +154,7 @@ std::vector<RaySet> Runner::make_ray_sets(const Target& target) const {
 }
 
 void Runner::run_scene(const SceneSpec& scene) {
+  if (scene.frames > 0) return run_animated_scene(scene);
   const auto t0 = std::chrono::steady_clock::now();
   const Target target = load(scene);
   std::vector<RaySet> sets = make_ray_sets(target);
@@ -143,6 +164,98 @@ void Runner::run_scene(const SceneSpec& scene) {
   for (const AccelSpec& spec : suite_.accelerators) {
     if (stopping()) return;
     run_config(target, scene, spec, sets);
+  }
+}
+
+std::vector<Runner::FrameCase> Runner::frame_cases(const SceneSpec& scene) const {
+  std::vector<FrameCase> cases;
+  // Rebuild first, so that every other strategy's SAH cost has a fresh build's on the same frame to compare.
+  for (const AccelSpec& spec : suite_.accelerators)
+    for (const UpdateStrategy s : all_update_strategies()) {
+      const std::string name = strategy_name(s);
+      if (std::find(scene.strategies.begin(), scene.strategies.end(), name) == scene.strategies.end())
+        continue;
+      if (!FrameUpdater::supports(spec.name, Params(spec.params), s)) continue;
+      FrameCase c{spec, name,
+                  std::make_unique<FrameUpdater>(spec.name, Params(spec.params), s, scene.threshold)};
+      c.spec.label = spec.label + ":" + name;
+      cases.push_back(std::move(c));
+    }
+  return cases;
+}
+
+// An animated scene (docs/dynamic.md): per frame, the frame's scene, ray sets (its camera, its geometry) and
+// reference answers, then every configuration x strategy updated (timed alone), verified and timed.
+void Runner::run_animated_scene(const SceneSpec& scene) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Target first = load(scene);
+  if (!first.scene || !first.scene->animated())
+    throw InputError(scene.path + ": " + scene.field +
+                     ": 'frames' needs an animated scene (this one is static)");
+  std::vector<FrameCase> cases = frame_cases(scene);
+  for (uint64_t f = 0; f < scene.frames; ++f) {
+    if (stopping()) return;
+    auto frame = std::make_shared<const Scene>(scene_at(*first.scene, frame_time(f, scene.frames)));
+    const Target target = scene_target(frame, first.path);
+    std::vector<RaySet> sets = make_ray_sets(target);
+    make_references(target, scene.label + " frame " + std::to_string(f), suite_.verify, sets, failure_sink());
+    if (f == 0) {
+      json entry = scene_entry(scene, target, sets, seconds_since(t0));
+      entry["frames"] = scene.frames;
+      entry["strategies"] = scene.strategies;
+      entry["threshold"] = scene.threshold;
+      report_["scenes"].push_back(entry);
+    }
+    progress_.step(scene.label + " frame " + std::to_string(f) + ": references ready");
+    std::map<std::string, double> rebuild_cost;  // configuration label -> a fresh build's SAH cost this frame
+    for (FrameCase& c : cases) {
+      if (stopping()) return;
+      run_frame(c, target, scene, f, sets, rebuild_cost);
+    }
+  }
+}
+
+/// One frame of one configuration x strategy: the update (timed alone, once: a frame's update changes the
+/// structure, so it is not repeated), its build entry, then every ray set verified and timed as for a
+/// static scene. The rows carry frame, strategy, update_seconds and the SAH cost against a rebuild's.
+void Runner::run_frame(FrameCase& c, const Target& target, const SceneSpec& scene, uint64_t frame,
+                       std::vector<RaySet>& sets, std::map<std::string, double>& rebuild_cost) {
+  const FrameUpdate u = c.updater->update(target.scene);
+  const Accelerator& accel = c.updater->accelerator();
+  Timing t;
+  t.median = t.min = t.max = t.mean = u.seconds;
+  t.repetitions = 1;
+  t.iterations = 1;
+  t.samples = {u.seconds};
+  const std::string base_label = c.spec.label.substr(0, c.spec.label.rfind(':'));
+  if (u.rebuilt && !rebuild_cost.count(base_label)) rebuild_cost[base_label] = u.sah_cost;
+  const json frame_fields = {{"frame", frame},
+                             {"frames", scene.frames},
+                             {"strategy", c.strategy},
+                             {"update_seconds", u.seconds},
+                             {"rebuilt", u.rebuilt},
+                             {"update_sah_cost", u.sah_cost > 0 ? json(u.sah_cost) : json()},
+                             {"sah_ratio_to_rebuild",
+                              rebuild_cost.count(base_label) && rebuild_cost[base_label] > 0 && u.sah_cost > 0
+                                  ? json(u.sah_cost / rebuild_cost[base_label])
+                                  : json()}};
+  json base = configuration_fields(scene.label, target, c.spec, accel, t);
+  base.update(frame_fields);
+  json entry = build_entry(scene.label, target, c.spec, accel, t);
+  entry.update(frame_fields);
+  report_["builds"].push_back(entry);
+  const std::string where = scene.label + " frame " + std::to_string(frame) + " / " + c.spec.label;
+  progress_.step(where + ": updated");
+  if (suite_.build_only) {
+    json row = base;
+    row["query"] = "build";
+    row["verified"] = true;
+    report_["results"].push_back(row);
+    return;
+  }
+  for (RaySet& set : sets) {
+    if (stopping()) return;
+    run_ray_set(accel, target, where + " / " + set.spec->label, c.spec, set, base);
   }
 }
 

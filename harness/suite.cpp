@@ -13,6 +13,8 @@
 #include "datasets/generators.h"
 #include "datasets/rays.h"
 #include "harness/selection.h"
+#include "tracer/scene.h"
+#include "tracer/update_strategy.h"
 #include "tracer/workload.h"
 
 namespace ab {
@@ -149,17 +151,51 @@ void parse_generator_scene(const json& s, const Where& w, std::vector<SceneSpec>
     }
 }
 
+/// An animated scene's "frames", "strategies" and "threshold" (docs/suites.md, docs/dynamic.md).
+void parse_animation(const json& s, const Where& w, SceneSpec& spec) {
+  const bool any = s.contains("frames") || s.contains("strategies") || s.contains("threshold");
+  if (!any) return;
+  if (spec.source != SceneSpec::Source::kScene) w.fail("'frames' and 'strategies' need an animated 'scene'");
+  if (!s.contains("frames")) w.fail("missing field 'frames' (an animated scene's frame count)");
+  spec.frames = read_count(s["frames"], w.at("frames"), 2, 100000);
+  spec.strategies = {"rebuild", "refit"};
+  if (s.contains("strategies")) {
+    const json& list = s["strategies"];
+    const Where ws = w.at("strategies");
+    if (!list.is_array() || list.empty()) ws.fail("expected a non-empty list of strategies");
+    spec.strategies.clear();
+    std::set<std::string> seen;
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string name = read_string(list[i], ws.at(i));
+      try {
+        parse_strategy(name);
+      } catch (const ParamError& e) {
+        ws.at(i).fail(e.what());
+      }
+      if (!seen.insert(name).second) ws.at(i).fail("duplicate strategy '" + name + "'");
+      spec.strategies.push_back(name);
+    }
+  }
+  if (s.contains("threshold")) {
+    const json& t = s["threshold"];
+    if (!t.is_number() || t.get<double>() <= 1.0 || t.get<double>() > 100.0)
+      w.at("threshold").fail("expected a number in (1, 100] (rebuild once the SAH cost grew by this factor)");
+    spec.threshold = t.get<double>();
+  }
+}
+
 void parse_file_scene(const json& s, const Where& w, const std::string& base_dir,
                       std::vector<SceneSpec>& out) {
   const bool is_mesh = s.contains("mesh");
   const std::string key = is_mesh ? "mesh" : "scene";
-  check_keys(s, w, {key, "label"});
+  check_keys(s, w, {key, "label", "frames", "strategies", "threshold"});
   SceneSpec spec;
   spec.source = is_mesh ? SceneSpec::Source::kMesh : SceneSpec::Source::kScene;
   spec.path = resolve(read_string(s[key], w.at(key)), base_dir);
   spec.label = s.contains("label") ? read_string(s["label"], w.at("label"))
                                    : std::filesystem::path(spec.path).stem().string();
   spec.field = w.field;
+  parse_animation(s, w, spec);
   out.push_back(std::move(spec));
 }
 
@@ -403,6 +439,8 @@ void validate_scenes(const Suite& suite) {
     if (s.source != SceneSpec::Source::kGenerator) {
       if (!std::filesystem::is_regular_file(s.path))
         w.at(s.source == SceneSpec::Source::kMesh ? "mesh" : "scene").fail(s.path + ": no such file");
+      if (s.frames > 0 && !load_scene(s.path).animated())
+        w.at("frames").fail(s.path + " is not animated (nothing moves over time)");
       continue;
     }
     const auto& gens = generators();

@@ -20,7 +20,10 @@ struct SceneSpec {
   uint64_t seed = 1;                          ///< generator seed (kGenerator)
   std::map<std::string, std::string> params;  ///< generator parameters (kGenerator)
   std::string path;                           ///< file (kMesh, kScene), resolved against the suite's folder
-  std::string field;  ///< where it came from in the suite ("scenes[2]"), for error messages
+  std::string field;    ///< where it came from in the suite ("scenes[2]"), for error messages
+  uint64_t frames = 0;  ///< an animated scene followed over this many frames (0: one static scene)
+  std::vector<std::string> strategies;  ///< per-frame update strategies (tracer/update_strategy.h)
+  double threshold = 1.5;               ///< adaptive: rebuild once the SAH cost grew past this factor
 };
 
 /// One accelerator configuration: a name and one value per parameter (grids are already expanded).
