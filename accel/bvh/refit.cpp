@@ -1,5 +1,7 @@
 #include "accel/bvh/refit.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 
 namespace ab {
@@ -47,16 +49,28 @@ AABB refresh_leaf_triangles(Triangle* out, const uint32_t* ids, uint32_t count, 
 }
 
 AABB refresh_leaf_blocks(Triangle4* blocks, const uint32_t* ids, uint32_t count, const TrianglePrims& prims) {
-  AABB box;
+  // Lanes are written in place (padding lanes keep the zero-area triangle of the build); the bounds of a
+  // full block come from four-lane min and max over its three corners, a partial block's lane by lane.
+  __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);  // lanes x, y, z (the fourth unused)
   for (uint32_t s = 0, b = 0; s < count; s += 4, ++b) {
-    Triangle quad[4] = {};
+    Triangle4& block = blocks[b];
     const uint32_t m = std::min(4u, count - s);
     for (uint32_t j = 0; j < m; ++j) {
-      quad[j] = prims.triangle(ids[s + j]);
-      box.extend(quad[j].bounds());
+      const Triangle& t = prims.triangle(ids[s + j]);
+      const vec3* corners[3] = {&t.v0, &t.v1, &t.v2};
+      for (int c = 0; c < 3; ++c) {
+        for (int a = 0; a < 3; ++a) block.v[c][a][j] = (*corners[c])[a];
+        const __m128 p = _mm_setr_ps(corners[c]->x, corners[c]->y, corners[c]->z, 0.0f);
+        lo = _mm_min_ps(lo, p);
+        hi = _mm_max_ps(hi, p);
+      }
     }
-    blocks[b] = Triangle4::pack(std::span<const Triangle>(quad, m));
   }
+  alignas(16) float l[4], h[4];
+  _mm_store_ps(l, lo);
+  _mm_store_ps(h, hi);
+  AABB box;
+  if (count > 0) box = {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
   return box;
 }
 

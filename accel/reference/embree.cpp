@@ -29,7 +29,11 @@ void EmbreeMesh::commit_frame(std::shared_ptr<const TrianglePrims> prims, RTCBui
   const Mesh& mesh = prims_->mesh();
   if (!dynamic_ || quality != geometry_quality_ || mesh.vertices.size() != old_vertices || mesh.size() == 0) {
     if (scene_) rtcReleaseScene(scene_);
-    scene_ = commit_mesh_scene(mesh, config_.quality, RTC_SCENE_FLAG_DYNAMIC, quality);
+    // Embree honours a geometry's own quality (RTC_BUILD_QUALITY_REFIT) only under a low-quality scene,
+    // whose two-level build builds each geometry apart (rtcSetGeometryBuildQuality(3)).
+    const RTCBuildQuality scene_quality =
+        quality == RTC_BUILD_QUALITY_REFIT ? RTC_BUILD_QUALITY_LOW : quality;
+    scene_ = commit_mesh_scene(mesh, scene_quality, RTC_SCENE_FLAG_DYNAMIC, quality);
     dynamic_ = true;
     geometry_quality_ = quality;
     return;

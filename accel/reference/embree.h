@@ -37,7 +37,8 @@ class EmbreeMesh final : public Accelerator {
 
   /// Moves the mesh to `prims` (the same triangles, new vertex positions) and commits it again in a dynamic
   /// scene (RTC_SCENE_FLAG_DYNAMIC) whose geometry has build quality `quality`: RTC_BUILD_QUALITY_REFIT
-  /// refits Embree's BVH, low or medium rebuild it. The first call (or a change of quality or vertex count)
+  /// refits Embree's BVH (in a low-quality scene: Embree honours a geometry's quality only there), low or
+  /// medium rebuild it (in a scene of that quality). The first call (or a change of quality or vertex count)
   /// makes the dynamic scene; later calls update the vertex buffer in place. Not timed here.
   void commit_frame(std::shared_ptr<const TrianglePrims> prims, RTCBuildQuality quality);
 
