@@ -38,6 +38,7 @@ int run_trace(const TraceArgs& a) {
     // The counting pass is separate, so counters never slow the timed pass above.
     std::vector<Hit> counted(rays.size());
     const RayCounters counters = trace_closest_counted(*accel, rays, counted, a.threads);
+    accel->measure_quality();
     nlohmann::json j = {{"accelerator", accel->name()},
                         {"requested", a.accel},
                         {"params", accel->config()},

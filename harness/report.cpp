@@ -44,6 +44,7 @@ const std::vector<std::string>& csv_columns() {
                                                 "mailbox_skips_per_ray",
                                                 "havran_cost_per_ray",
                                                 "sah_cost",
+                                                "epo",
                                                 "build_seconds_median",
                                                 "build_seconds_min",
                                                 "build_seconds_max",
@@ -147,14 +148,16 @@ void print_verification_line(std::ostream& out, const nlohmann::json& report) {
 }
 
 void print_correlation_line(std::ostream& out, const nlohmann::json& report) {
-  std::vector<double> r;
-  for (const auto& g : report.value("sah_correlation", nlohmann::json::array()))
-    if (g["pearson"].is_number()) r.push_back(g["pearson"].get<double>());
-  if (r.empty()) return;
-  std::sort(r.begin(), r.end());
-  out << "SAH cost vs measured cost per ray (Pearson r over configurations): median "
-      << fmt(r[r.size() / 2], 2) << ", min " << fmt(r.front(), 2) << ", max " << fmt(r.back(), 2) << " over "
-      << r.size() << " scene x ray set groups\n";
+  for (const auto& [key, name] : {std::pair{"pearson", "SAH cost"}, std::pair{"epo_pearson", "EPO"}}) {
+    std::vector<double> r;
+    for (const auto& g : report.value("sah_correlation", nlohmann::json::array()))
+      if (g.contains(key) && g[key].is_number()) r.push_back(g[key].get<double>());
+    if (r.empty()) continue;
+    std::sort(r.begin(), r.end());
+    out << name << " vs measured cost per ray (Pearson r over configurations): median "
+        << fmt(r[r.size() / 2], 2) << ", min " << fmt(r.front(), 2) << ", max " << fmt(r.back(), 2)
+        << " over " << r.size() << " scene x ray set groups\n";
+  }
 }
 
 }  // namespace

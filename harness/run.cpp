@@ -146,8 +146,9 @@ std::vector<RaySet> Runner::make_ray_sets(const Target& target) const {
   for (const RaySpec& spec : suite_.rays) {
     RaySet set;
     set.spec = &spec;
-    set.rays = spec.path.empty() ? make_target_rays(target, rt, spec.kind, spec.count, suite_.seed)
-                                 : read_rays(spec.path);
+    set.rays = spec.path.empty()
+                   ? make_target_rays(target, rt, spec.kind, spec.count, suite_.seed, spec.views)
+                   : read_rays(spec.path);
     sets.push_back(std::move(set));
   }
   return sets;
@@ -271,6 +272,7 @@ std::unique_ptr<Accelerator> Runner::build(const Target& target, const std::stri
     return accel->stats().build_seconds;
   };
   const Timing t = timer_.time_build("build/" + scene + "/" + spec.label, double(target.triangles), pass);
+  accel->measure_quality();
   base = configuration_fields(scene, target, spec, *accel, t);
   report_["builds"].push_back(build_entry(scene, target, spec, *accel, t));
   return accel;

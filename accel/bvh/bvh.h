@@ -24,6 +24,7 @@
 #include "accel/bvh/tree_visitors.h"
 #include "accel/bvh/walk2.h"
 #include "accel/bvh/walk8.h"
+#include "accel/common/epo.h"
 #include "accel/common/tree_stats.h"
 #include "accel/core/accelerator.h"
 #include "accel/core/primitives.h"
@@ -155,6 +156,11 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
                   blocks_.blocks.size() * sizeof(Triangle4) + blocks_.ids.size() * sizeof(uint32_t);
   }
 
+  /// The end-point overlap of the tree as traversed (over triangles only).
+  void gather_quality(BuildStats& stats) const override {
+    if constexpr (kCopiesTriangles) stats.epo = tree_epo();
+  }
+
  private:
   friend struct BvhRefit<Bvh>;
   static constexpr bool kCopiesTriangles = std::is_same_v<P, TrianglePrims>;
@@ -182,6 +188,24 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     if (!nodes_.empty()) walk_tree_stats(BvhTreeVisitor{nodes_}, binary_);
     wide_ = collapse_to_bvh8(nodes_);
     BvhNodeArray().swap(nodes_);
+  }
+
+  /// End-point overlap (accel/common/epo.h) of the tree as traversed: the binary tree for width 2, the
+  /// wide tree for width 8 (its leaves' triangles from the block lanes).
+  double tree_epo() const {
+    const auto triangle = [&](size_t id) { return prims_->triangle(id); };
+    if (!nodes_.empty()) {
+      const auto leaf = [&](uint32_t i, auto&& f) {
+        for (uint32_t k = nodes_[i].offset; k < nodes_[i].offset + nodes_[i].count; ++k) f(order_[k]);
+      };
+      return end_point_overlap(BvhTreeVisitor{nodes_}, leaf, prims_->size(), triangle);
+    }
+    if (wide_.empty()) return -1.0;
+    const auto leaf = [&](const Bvh8TreeVisitor::Node& n, auto&& f) {
+      for (uint32_t k = 4 * n.child; k < 4 * (n.child + (n.count + 3) / 4); ++k)
+        if (blocks_.ids[k] != kInvalidId) f(blocks_.ids[k]);
+    };
+    return end_point_overlap(Bvh8TreeVisitor{wide_}, leaf, prims_->size(), triangle);
   }
 
   /// The wide tree's triangle blocks as bytes for prefetching (null for other primitive sets).

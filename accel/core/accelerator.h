@@ -59,6 +59,9 @@ class Accelerator {
   virtual AABB bounds() const = 0;
   /// Statistics of the last build.
   const BuildStats& stats() const { return stats_; }
+  /// Adds the quality metrics that cost more than a build (the BVHs' end-point overlap) to stats(); not
+  /// part of build(), so repeated timed builds do not pay for them: call it once where they are reported.
+  void measure_quality() { gather_quality(stats_); }
 
   /// Closest hit of every ray (hits[i] is overwritten).
   virtual void intersect(std::span<const Ray> rays, std::span<Hit> hits) const = 0;
@@ -89,6 +92,8 @@ class Accelerator {
   virtual bool do_refit_triangles(std::shared_ptr<const TrianglePrims>) { return false; }
   /// The refit over moved instances (refit()); false when unsupported.
   virtual bool do_refit_instances(std::shared_ptr<const InstancePrims>) { return false; }
+  /// Fills the expensive quality metrics of the finished structure (measure_quality()).
+  virtual void gather_quality(BuildStats& stats) const { (void)stats; }
   BuildStats stats_;
 
  private:

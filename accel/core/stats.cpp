@@ -17,6 +17,7 @@ nlohmann::json to_json(const BuildStats& s) {
           {"bytes", s.bytes},
           {"bytes_per_primitive", s.bytes_per_primitive()},
           {"sah_cost", s.sah_cost},
+          {"epo", s.epo >= 0 ? nlohmann::json(s.epo) : nlohmann::json()},
           {"leaf_size_histogram", hist},
           {"extra", s.extra}};
 }

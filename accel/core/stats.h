@@ -37,6 +37,7 @@ struct BuildStats {
   uint64_t references = 0;       ///< primitive references stored in leaves or cells
   uint64_t bytes = 0;            ///< memory of the structure itself (not the input mesh)
   double sah_cost = 0.0;         ///< SAH cost, costs 1 and 1, normalized by the root's area (0: not computed)
+  double epo = -1.0;  ///< end-point overlap (accel/common/epo.h), costs 1 and 1 (< 0: not computed)
   std::map<uint32_t, uint64_t> leaf_size_histogram;  ///< primitives per leaf -> number of leaves
   nlohmann::json extra = nlohmann::json::object();   ///< structure-specific figures (grid resolution, ...)
 
