@@ -32,15 +32,31 @@ Frame frame_of(const AABB& bounds) {
   return f;
 }
 
-/// A pinhole camera looking at the box centre from a fixed direction, just far enough back that
+/// The default camera's viewing direction (view 0 of every `views` count).
+vec3 default_forward() {
+  return glm::normalize(vec3(-0.55f, -0.45f, -0.7f));
+}
+
+/// Viewing direction of view v of `views`: the default direction turned about the vertical (y) axis by
+/// 2 pi v / views, so the cameras stand evenly around the bounds at the default camera's elevation (Aila
+/// and Laine 2009 measure each scene from several such viewpoints).
+vec3 view_forward(uint32_t v, uint32_t views) {
+  const vec3 f = default_forward();
+  if (v == 0) return f;
+  const double a = 2.0 * 3.14159265358979323846 * double(v) / double(views);
+  const float c = float(std::cos(a)), s = float(std::sin(a));
+  return glm::normalize(vec3(c * f.x + s * f.z, f.y, c * f.z - s * f.x));
+}
+
+/// A pinhole camera looking at the box centre from direction `forward`, just far enough back that
 /// all eight box corners fit the 45 degree field of view, with a width x height pixel grid.
 struct Camera {
   vec3 eye, forward, right, up;
   float tan_half;
   uint64_t width, height;
 
-  Camera(const Frame& f, uint64_t count) {
-    forward = glm::normalize(vec3(-0.55f, -0.45f, -0.7f));
+  Camera(const Frame& f, uint64_t count, vec3 view = default_forward()) {
+    forward = view;
     tan_half = std::tan(22.5f * kPi / 180.0f);
     right = glm::normalize(glm::cross(forward, vec3(0.0f, 1.0f, 0.0f)));
     up = glm::cross(right, forward);
@@ -169,12 +185,18 @@ vec3 hemisphere_direction(Rng& rng) {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
-std::vector<Ray> primary_rays(const Frame& f, uint64_t count, uint64_t seed) {
-  const Camera camera(f, count);
+/// Primary rays from `views` cameras around the bounds: view v makes rays [v count / views, (v + 1) count /
+/// views), one per pixel of its own grid; ray i's jitter depends on (seed, i) alone.
+std::vector<Ray> primary_rays(const Frame& f, uint64_t count, uint64_t seed, uint32_t views) {
   std::vector<Ray> rays(count);
-  for (uint64_t i = 0; i < count; ++i) {
-    Rng rng = ray_rng(seed, 1, i);
-    rays[i] = camera.ray(i, rng);
+  for (uint32_t v = 0; v < views; ++v) {
+    const uint64_t begin = count * v / views, end = count * (v + 1) / views;
+    if (begin == end) continue;
+    const Camera camera(f, end - begin, view_forward(v, views));
+    for (uint64_t i = begin; i < end; ++i) {
+      Rng rng = ray_rng(seed, 1, i);
+      rays[i] = camera.ray(i - begin, rng);
+    }
   }
   return rays;
 }
@@ -213,7 +235,8 @@ std::vector<Ray> secondary_rays(const RayTarget& target, const Frame& f, uint64_
 
 const std::vector<RayKindInfo>& ray_kinds() {
   static const std::vector<RayKindInfo> kinds = {
-      {"primary", "pinhole camera framing the bounds, one jittered ray per pixel"},
+      {"primary",
+       "pinhole camera framing the bounds, one jittered ray per pixel (views=V: V cameras around it)"},
       {"incoherent", "random origin inside the bounds, uniform random direction"},
       {"shadow", "from primary hit points to a point light above the bounds (finite tmax)"},
       {"diffuse", "cosine-weighted bounce from primary hit points"},
@@ -223,9 +246,12 @@ const std::vector<RayKindInfo>& ray_kinds() {
   return kinds;
 }
 
-std::vector<Ray> make_rays(const std::string& kind, const RayTarget& target, uint64_t count, uint64_t seed) {
+std::vector<Ray> make_rays(const std::string& kind, const RayTarget& target, uint64_t count, uint64_t seed,
+                           uint32_t views) {
+  if (views == 0) throw InputError("views must be at least 1");
+  if (views != 1 && kind != "primary") throw InputError("views applies to the primary ray kind only");
   const Frame f = frame_of(target.bounds);
-  if (kind == "primary") return primary_rays(f, count, seed);
+  if (kind == "primary") return primary_rays(f, count, seed, views);
   if (kind == "incoherent") return incoherent_rays(f, count, seed);
   if (kind == "shadow") {
     const vec3 light(f.center.x + 0.2f * f.diag, f.box.hi.y + 0.5f * f.diag, f.center.z + 0.1f * f.diag);

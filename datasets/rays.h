@@ -28,8 +28,10 @@ struct RayKindInfo {
 /// Every ray kind, in listing order.
 const std::vector<RayKindInfo>& ray_kinds();
 
-/// Makes exactly `count` rays of `kind`; deterministic in (kind, target geometry, count, seed).
-/// Throws InputError for an unknown kind.
-std::vector<Ray> make_rays(const std::string& kind, const RayTarget& target, uint64_t count, uint64_t seed);
+/// Makes exactly `count` rays of `kind`; deterministic in (kind, target geometry, count, seed, views).
+/// `views` (primary rays only) splits the rays evenly over that many cameras placed around the bounds;
+/// views = 1 is the one default camera. Throws InputError for an unknown kind or a bad `views`.
+std::vector<Ray> make_rays(const std::string& kind, const RayTarget& target, uint64_t count, uint64_t seed,
+                           uint32_t views = 1);
 
 }  // namespace ab

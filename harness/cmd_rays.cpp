@@ -1,4 +1,4 @@
-// `accelbench rays (--mesh F | --scene F) --kind KIND --count N [--seed S] -o FILE.rays`
+// `accelbench rays (--mesh F | --scene F) --kind KIND --count N [--seed S] [--views V] -o FILE.rays`
 #include <memory>
 
 #include "datasets/rays.h"
@@ -15,6 +15,7 @@ struct RaysArgs {
   std::string kind;
   uint64_t count = 0;
   uint64_t seed = 1;
+  uint32_t views = 1;
   std::string output;
 };
 
@@ -27,12 +28,14 @@ const CommandRegistrar kRays{
            ->required()
            ->check(CLI::Range(uint64_t{0}, uint64_t{1'000'000'000}));
        app.add_option("--seed", a->seed, "random seed");
+       app.add_option("--views", a->views, "primary rays from V cameras placed around the bounds (default 1)")
+           ->check(CLI::Range(uint32_t{1}, uint32_t{4096}));
        app.add_option("-o,--output", a->output, "output .rays file")->required();
        return [a] {
          const Target target =
              load_target(a->target.mesh, a->target.scene, a->target.frame.normalized_time());
          // Scenes: the tracer's own kinds (camera and lights of the scene).
-         const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed);
+         const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed, a->views);
          write_rays(a->output, rays);
          return 0;
        };

@@ -71,6 +71,7 @@ json scene_entry(const SceneSpec& scene, const Target& target, const std::vector
   for (const RaySet& s : sets)
     info["ray_sets"].push_back({{"label", s.spec->label},
                                 {"kind", s.spec->kind},
+                                {"views", s.spec->views},
                                 {"file", s.spec->path},
                                 {"count", s.rays.size()},
                                 {"brute_checked", s.brute_checked}});
@@ -78,42 +79,47 @@ json scene_entry(const SceneSpec& scene, const Target& target, const std::vector
   return info;
 }
 
+namespace {
+
+/// The fields naming a configuration on a scene, shared by result rows and build entries.
+json configuration_identity(const std::string& scene, const Target& target, const AccelSpec& spec,
+                            const Accelerator& accel) {
+  return {{"scene", scene},           {"triangles", target.triangles},
+          {"accelerator", spec.name}, {"config_label", spec.label},
+          {"params", spec.params},    {"config", accel.config()}};
+}
+
+}  // namespace
+
 json configuration_fields(const std::string& scene, const Target& target, const AccelSpec& spec,
                           const Accelerator& accel, const Timing& build) {
   const BuildStats& s = accel.stats();
   const double tri = target.triangles ? double(target.triangles) : 1.0;
-  return {{"scene", scene},
-          {"triangles", target.triangles},
-          {"accelerator", spec.name},
-          {"config_label", spec.label},
-          {"params", spec.params},
-          {"config", accel.config()},
-          {"build_seconds_median", build.median},
-          {"build_seconds_min", build.min},
-          {"build_seconds_max", build.max},
-          {"bytes", s.bytes},
-          {"bytes_per_triangle", double(s.bytes) / tri},
-          {"nodes", s.nodes},
-          {"leaves", s.leaves},
-          {"max_depth", s.max_depth},
-          {"references_per_triangle", double(s.references) / tri},
-          {"sah_cost", s.sah_cost > 0 ? json(s.sah_cost) : json()}};
+  json j = configuration_identity(scene, target, spec, accel);
+  j.update({{"build_seconds_median", build.median},
+            {"build_seconds_min", build.min},
+            {"build_seconds_max", build.max},
+            {"bytes", s.bytes},
+            {"bytes_per_triangle", double(s.bytes) / tri},
+            {"nodes", s.nodes},
+            {"leaves", s.leaves},
+            {"max_depth", s.max_depth},
+            {"references_per_triangle", double(s.references) / tri},
+            {"sah_cost", s.sah_cost > 0 ? json(s.sah_cost) : json()},
+            {"epo", s.epo >= 0 ? json(s.epo) : json()}});
+  return j;
 }
 
 json build_entry(const std::string& scene, const Target& target, const AccelSpec& spec,
                  const Accelerator& accel, const Timing& build) {
   const BuildStats& s = accel.stats();
   const double tri = target.triangles ? double(target.triangles) : 1.0;
-  return {{"scene", scene},
-          {"triangles", target.triangles},
-          {"accelerator", spec.name},
-          {"config_label", spec.label},
-          {"params", spec.params},
-          {"config", accel.config()},
-          {"build_seconds", timing_json(build)},
-          {"bytes_per_triangle", double(s.bytes) / tri},
-          {"stats", to_json(s)},
-          {"verification", json::array()}};
+  json j = configuration_identity(scene, target, spec, accel);
+  j.update({{"build_seconds", timing_json(build)},
+            {"bytes_per_triangle", double(s.bytes) / tri},
+            {"stats", to_json(s)},
+            {"verification", json::array()}});
+  return j;
 }
 
 json per_ray_fields(const RayCounters& counters, size_t rays) {

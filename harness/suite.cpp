@@ -251,7 +251,7 @@ std::vector<RaySpec> parse_rays(const json& j, const Where& w, const std::string
   std::vector<RaySpec> out;
   for (size_t i = 0; i < j.size(); ++i) {
     const Where wi = w.at(i);
-    check_keys(j[i], wi, {"kind", "count", "file", "any_hit", "label"});
+    check_keys(j[i], wi, {"kind", "count", "file", "any_hit", "label", "views"});
     RaySpec spec;
     spec.field = wi.field;
     if (j[i].contains("file") == j[i].contains("kind"))
@@ -262,8 +262,14 @@ std::vector<RaySpec> parse_rays(const json& j, const Where& w, const std::string
       spec.count = read_count(j[i]["count"], wi.at("count"), 1, 1ull << 30);
       spec.label = spec.kind;
       spec.any_hit = spec.kind == "shadow";
+      if (j[i].contains("views")) {
+        if (spec.kind != "primary") wi.at("views").fail("applies to the primary ray kind only");
+        spec.views = uint32_t(read_count(j[i]["views"], wi.at("views"), 1, 4096));
+        if (spec.views > 1) spec.label += "-views" + std::to_string(spec.views);
+      }
     } else {
       if (j[i].contains("count")) wi.at("count").fail("not allowed with 'file' (the file gives the count)");
+      if (j[i].contains("views")) wi.at("views").fail("not allowed with 'file'");
       spec.path = resolve(read_string(j[i]["file"], wi.at("file")), base_dir);
       spec.label = "file:" + std::filesystem::path(spec.path).filename().string();
     }

@@ -38,6 +38,7 @@ struct AccelSpec {
 struct RaySpec {
   std::string kind;      ///< ray kind (empty for a file)
   uint64_t count = 0;    ///< rays to make (kind)
+  uint32_t views = 1;    ///< cameras around the bounds (kind "primary" only; make_rays)
   std::string path;      ///< .rays file, resolved against the suite's folder
   bool any_hit = false;  ///< also time any-hit (occlusion) queries; default true for kind "shadow"
   std::string label;     ///< unique name in reports ("primary", "shadow", "file:foo.rays")

@@ -77,15 +77,15 @@ RayTarget ray_target(const Target& target) {
 }
 
 std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count,
-                                  uint64_t seed) {
-  return make_target_rays(target, ray_target(target), kind, count, seed);
+                                  uint64_t seed, uint32_t views) {
+  return make_target_rays(target, ray_target(target), kind, count, seed, views);
 }
 
 std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind,
-                                  uint64_t count, uint64_t seed) {
-  if (target.scene && is_scene_ray_kind(kind))
+                                  uint64_t count, uint64_t seed, uint32_t views) {
+  if (target.scene && is_scene_ray_kind(kind) && views == 1)
     return make_scene_rays(*target.scene, rt.trace, kind, count, seed);
-  return make_rays(kind, rt, count, seed);
+  return make_rays(kind, rt, count, seed, views);
 }
 
 HitTriangleFn hit_triangles(const Target& target) {

@@ -39,12 +39,13 @@ std::unique_ptr<Accelerator> make_target_accelerator(const Target& target, const
 
 /// Exactly `count` rays of `kind` for the target: for a scene, the tracer's kinds (primary, dof, shadow,
 /// glossy, diffuse: tracer/workload.h) use its camera and lights; every other kind (and every kind for
-/// a mesh) comes from make_rays. Throws InputError for an unknown kind.
+/// a mesh) comes from make_rays. `views` > 1 (primary only) places that many cameras around the bounds,
+/// for a scene too (instead of its own camera). Throws InputError for an unknown kind or bad views.
 std::vector<Ray> make_target_rays(const Target& target, const std::string& kind, uint64_t count,
-                                  uint64_t seed);
+                                  uint64_t seed, uint32_t views = 1);
 /// The same with a RayTarget already made by ray_target(target) (so several ray sets share one build).
 std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, const std::string& kind,
-                                  uint64_t count, uint64_t seed);
+                                  uint64_t count, uint64_t seed, uint32_t views = 1);
 
 /// What ray generation needs of the target (bounds, a closest-hit trace through a fast structure of the
 /// project, normals at hits).

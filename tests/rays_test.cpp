@@ -137,5 +137,36 @@ TEST(RaysEdgeCases, MostlyEmptySpaceStillGivesExactCounts) {
   }
 }
 
+// views = 1 is the one default camera; with V views, view 0's block of rays is exactly the default
+// camera's rays for that block's count (the jitter depends on the ray index alone), and every view
+// looks at the box centre from its own eye.
+TEST_F(RaysTest, PrimaryViewsAroundTheBounds) {
+  const auto& t = flake_->target;
+  EXPECT_TRUE(same_bytes(make_rays("primary", t, 1000, 4), make_rays("primary", t, 1000, 4, 1)));
+  const std::vector<Ray> four = make_rays("primary", t, 1000, 4, 4);
+  ASSERT_EQ(four.size(), 1000u);
+  EXPECT_TRUE(same_bytes(four, make_rays("primary", t, 1000, 4, 4)));
+  const std::vector<Ray> first(four.begin(), four.begin() + 250);
+  EXPECT_TRUE(same_bytes(first, make_rays("primary", t, 250, 4)));
+  const vec3 centre = t.bounds.center();
+  std::vector<vec3> eyes;
+  for (int v = 0; v < 4; ++v) {
+    const Ray& r = four[size_t(v) * 250];
+    for (size_t i = size_t(v) * 250; i < size_t(v + 1) * 250; ++i) ASSERT_EQ(four[i].org, r.org);
+    EXPECT_GT(glm::dot(r.dir, centre - r.org), 0.0f) << "view " << v;
+    EXPECT_FALSE(t.bounds.contains(r.org)) << "view " << v;
+    for (const vec3& e : eyes) EXPECT_GT(glm::length(e - r.org), 0.1f * glm::length(t.bounds.extent()));
+    eyes.push_back(r.org);
+  }
+  // More views than rays: every ray still made, from the views that get one.
+  EXPECT_EQ(make_rays("primary", t, 3, 1, 8).size(), 3u);
+}
+
+TEST_F(RaysTest, ViewsOnlyForPrimaryRays) {
+  EXPECT_THROW(make_rays("shadow", flake_->target, 10, 1, 2), InputError);
+  EXPECT_THROW(make_rays("primary", flake_->target, 10, 1, 0), InputError);
+  EXPECT_NO_THROW(make_rays("shadow", flake_->target, 10, 1, 1));
+}
+
 }  // namespace
 }  // namespace ab

@@ -273,6 +273,45 @@ TEST(Harness, PearsonAndIterations) {
   EXPECT_EQ(iterations_for(0.001, 0.0), 1);
 }
 
+TEST(Suite, PrimaryViewsGetTheirOwnLabel) {
+  json j = minimal_suite();
+  j["rays"] = json::parse(R"([{"kind": "primary", "count": 16},
+                              {"kind": "primary", "count": 16, "views": 4}])");
+  const Suite s = parse_suite(j, "s.json", "");
+  ASSERT_EQ(s.rays.size(), 2u);
+  EXPECT_EQ(s.rays[0].views, 1u);
+  EXPECT_EQ(s.rays[1].views, 4u);
+  EXPECT_EQ(s.rays[1].label, "primary-views4");
+  j["rays"] = json::parse(R"([{"kind": "shadow", "count": 16, "views": 2}])");
+  EXPECT_NE(error_of(j).find("rays[0].views"), std::string::npos) << error_of(j);
+  j["rays"] = json::parse(R"([{"kind": "primary", "count": 16, "views": 0}])");
+  EXPECT_NE(error_of(j).find("rays[0].views"), std::string::npos) << error_of(j);
+}
+
+// The correlation analysis gives Pearson's r of the SAH cost and of EPO against the measured cost per ray,
+// each over the configurations that report the metric.
+TEST(Harness, CorrelatesSahAndEpoWithMeasuredCost) {
+  json report = {{"results", json::array()}};
+  const double sah[] = {1, 2, 3, 4}, epo[] = {4, 3, 2, 1}, cost[] = {10, 20, 30, 40};
+  for (int i = 0; i < 4; ++i)
+    report["results"].push_back({{"scene", "s"},
+                                 {"rays", "primary"},
+                                 {"query", "closest"},
+                                 {"threads", 1},
+                                 {"config_label", "c" + std::to_string(i)},
+                                 {"sah_cost", sah[i]},
+                                 {"epo", epo[i]},
+                                 {"havran_cost_per_ray", cost[i]}});
+  report["results"][0]["epo"] = nullptr;  // a configuration without EPO (not a BVH)
+  fill_correlations(report, 1);
+  ASSERT_EQ(report["sah_correlation"].size(), 1u);
+  const json& g = report["sah_correlation"][0];
+  EXPECT_NEAR(g["pearson"].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(g["configurations"], 4);
+  EXPECT_NEAR(g["epo_pearson"].get<double>(), -1.0, 1e-12);
+  EXPECT_EQ(g["epo_configurations"], 3);
+}
+
 TEST(Harness, CsvQuotesAndFlattens) {
   json report = {{"results", json::array()}};
   report["results"].push_back({{"scene", "a,b"},
