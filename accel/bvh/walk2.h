@@ -52,6 +52,18 @@ struct BvhPairTest {
   int near_index[3], far_index[3];  ///< float index in a node of the near and far plane per axis
 };
 
+/// The test of a binary node type's sibling pairs: BvhPairTest for the box nodes; a node of another bound
+/// names its own (`using PairTest = ...;`, as bvh-sphere's SphereNode does).
+template <class Node>
+struct BvhPairTestOf {
+  using type = typename Node::PairTest;  ///< the node's own test
+};
+/// The box nodes' test.
+template <>
+struct BvhPairTestOf<BvhNode> {
+  using type = BvhPairTest;  ///< the slab test of both boxes
+};
+
 /// A node waiting on the binary walk's stack, with the distance at which the ray enters it.
 struct BvhStackEntry {
   uint32_t node;  ///< index in the node array
@@ -61,22 +73,23 @@ struct BvhStackEntry {
   float entry() const { return t; }
 };
 
-/// Front-to-back walk of a binary BVH (nodes as build_bvh lays them out; not empty). `limit()` is the
+/// Front-to-back walk of a binary BVH (nodes as build_bvh lays them out; not empty; BvhNode, or a node of
+/// another bound with is_leaf(), offset and count, tested by its BvhPairTestOf). `limit()` is the
 /// current upper bound of the box tests (min(tmax, best.t) for closest hit, tmax for any hit);
 /// `leaf(first, count)` tests a leaf's primitives [first, first + count) of leaf order and returns true
 /// to end the walk. The nearer entered child is visited first, the farther one is stacked (and, with
 /// kPrefetchFar, its children's pair prefetched: closest hit visits most stacked nodes, any hit often ends
 /// before); a stacked node is skipped only when its entry lies strictly beyond limit(). Returns true when
 /// a leaf ended the walk.
-template <bool kCount, bool kPrefetchFar, class Limit, class Leaf>
-[[gnu::always_inline]] inline bool walk_bvh2(const BvhNode* nodes, const Ray& ray, Limit limit, Leaf leaf,
+template <bool kCount, bool kPrefetchFar, class Limit, class Leaf, class Node>
+[[gnu::always_inline]] inline bool walk_bvh2(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
                                              RayCounters& c) {
-  const BvhPairTest test(ray);
+  const typename BvhPairTestOf<Node>::type test(ray);
   if (test.entry(nodes[0], limit()) == kInf) return false;
   TraversalStack<BvhStackEntry, kBvhMaxDepth + 2> stack;
   uint32_t idx = 0;
   for (;;) {
-    const BvhNode& n = nodes[idx];
+    const Node& n = nodes[idx];
     if constexpr (kCount) ++c.nodes;
     if (!n.is_leaf()) {
       const uint32_t l = n.offset, r = n.offset + 1;
