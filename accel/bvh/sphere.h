@@ -1,6 +1,7 @@
 // bvh-sphere: a bounding-sphere hierarchy. A binary BVH whose nodes bound their children with spheres
-// instead of boxes (the alternative bounding volume of Rubin and Whitted 1980 and Weghorst, Hooper and
-// Greenberg 1984, "Improved computational methods for ray tracing"): the topology is bvh-sah's binary tree
+// instead of boxes (the bounding volume of Whitted 1980, "An improved illumination model for shaded
+// display", which Weghorst, Hooper and Greenberg 1984, "Improved computational methods for ray tracing",
+// compared with boxes and cylinders): the topology is bvh-sah's binary tree
 // (binned SAH, Wald 2007; build.h), each node gets the smaller of Ritter's sphere over its points and the
 // sphere around its children's (sphere_fit.h), and the one binary walk (walk2.h) tests sibling pairs with
 // the conservative ray/sphere test (sphere_entry.h). It is also the worked example of
