@@ -1,10 +1,25 @@
 #include "accel/bvh/collapse.h"
 
+#include <array>
 #include <vector>
 
 namespace ab {
 
 namespace {
+
+/// The binary nodes that become one wide node's children (at most eight, no allocation).
+struct Kids {
+  std::array<uint32_t, Bvh8Node::kWidth> id;
+  size_t n = 0;
+
+  size_t size() const { return n; }
+  uint32_t operator[](size_t k) const { return id[k]; }
+  /// Puts b at position k, shifting the ones from k on (n < 8).
+  void insert(size_t k, uint32_t b) {
+    for (size_t j = n++; j > k; --j) id[j] = id[j - 1];
+    id[k] = b;
+  }
+};
 
 /// Recursive collapse of the binary tree into the wide array.
 class Bvh8Collapser {
@@ -15,7 +30,9 @@ class Bvh8Collapser {
   void run() {
     wide_.emplace_back();
     if (binary_[0].is_leaf()) {
-      fill(0, {0u});
+      Kids root;
+      root.insert(0, 0);
+      fill(0, root);
     } else {
       collapse(0, 0);
     }
@@ -23,8 +40,10 @@ class Bvh8Collapser {
 
  private:
   /// Children of binary interior node b: open the interior child of largest area until there are 8.
-  std::vector<uint32_t> children_of(uint32_t b) const {
-    std::vector<uint32_t> kids{binary_[b].offset, binary_[b].offset + 1};
+  Kids children_of(uint32_t b) const {
+    Kids kids;
+    kids.insert(0, binary_[b].offset);
+    kids.insert(1, binary_[b].offset + 1);
     while (kids.size() < size_t(Bvh8Node::kWidth)) {
       int pick = -1;
       float pick_area = -1.0f;
@@ -34,14 +53,14 @@ class Bvh8Collapser {
       }
       if (pick < 0) break;
       const uint32_t opened = kids[size_t(pick)];
-      kids[size_t(pick)] = binary_[opened].offset;
-      kids.insert(kids.begin() + pick + 1, binary_[opened].offset + 1);
+      kids.id[size_t(pick)] = binary_[opened].offset;
+      kids.insert(size_t(pick) + 1, binary_[opened].offset + 1);
     }
     return kids;
   }
 
   /// Writes the boxes and references of `kids` into wide node w (unused lanes stay empty).
-  void fill(uint32_t w, const std::vector<uint32_t>& kids) {
+  void fill(uint32_t w, const Kids& kids) {
     Bvh8Node& node = wide_[w];
     for (int k = 0; k < Bvh8Node::kWidth; ++k) {
       const bool used = size_t(k) < kids.size();
@@ -57,7 +76,7 @@ class Bvh8Collapser {
 
   /// Fills wide node w from binary interior node b; interior children get consecutive new wide nodes.
   void collapse(uint32_t b, uint32_t w) {
-    const std::vector<uint32_t> kids = children_of(b);
+    const Kids kids = children_of(b);
     fill(w, kids);
     for (size_t k = 0; k < kids.size(); ++k) {
       if (binary_[kids[k]].is_leaf()) continue;

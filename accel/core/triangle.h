@@ -75,6 +75,51 @@ inline T parallel_bound(const Vec3T<T>& dir, const Vec3T<T>& e1, const Vec3T<T>&
   return l1_norm(dir) * l1_norm(e1) * l1_norm(e2) * T(kCoplanarEps);
 }
 
+/// What the kernel computes from the triangle alone: v0, the edges e1 = v1 - v0 and e2 = v2 - v0 and the
+/// normal n = e1 x e2, with the same operations as triangle_kernel (so leaf blocks may store them, made
+/// once at build time, and give the same bits).
+template <class T>
+struct TriangleTerms {
+  Vec3T<T> v0, e1, e2, n;
+};
+
+/// The terms of triangle (v0, v1, v2).
+template <class T>
+[[gnu::always_inline]] inline TriangleTerms<T> triangle_terms(const Vec3T<T>& v0, const Vec3T<T>& v1,
+                                                             const Vec3T<T>& v2) {
+  const Vec3T<T> e1 = v1 - v0;
+  const Vec3T<T> e2 = v2 - v0;
+  return {v0, e1, e2, cross(e1, e2)};
+}
+
+/// The kernel after triangle_terms, with l1_dir = l1_norm(dir) (made once per ray): the operations of
+/// triangle_kernel from the denominator on, in the same order.
+template <class T>
+[[gnu::always_inline]] inline auto triangle_kernel_terms(const Vec3T<T>& org, const Vec3T<T>& dir, T l1_dir,
+                                                         T tmin, T tmax, const TriangleTerms<T>& tri, T& t,
+                                                         T& u, T& v) {
+  const T den = dot(dir, tri.n);
+  // A ray lying in the triangle's plane has den = 0 only in exact arithmetic; in floats it is rounding
+  // noise, and num/den then puts a "hit" anywhere along the ray, outside every box that holds the
+  // triangle. So den must exceed a bound on its rounding error (relative kCoplanarEps of the L1 product
+  // of |dir|, |e1|, |e2|), or the ray counts as parallel. The same rule for every structure keeps hits
+  // identical; such rays graze the plane within about 1e-5 radians (Embree's differ: verify calls them
+  // graze cases). Also rejects NaN. (parallel_bound's product, left to right.)
+  auto ok = lane_abs(den) > l1_dir * l1_norm(tri.e1) * l1_norm(tri.e2) * T(kCoplanarEps);
+  if (lane_none(ok)) return ok;
+  const T inv = T(1.0f) / den;
+  const Vec3T<T> to_origin = org - tri.v0;
+  const Vec3T<T> c = cross(dir, to_origin);
+  u = dot(tri.e2, c) * inv;
+  ok = lane_and(ok, u >= T(0.0f));
+  if (lane_none(ok)) return ok;
+  v = -dot(tri.e1, c) * inv;
+  ok = lane_and(ok, lane_and(v >= T(0.0f), u + v <= T(1.0f)));
+  if (lane_none(ok)) return ok;
+  t = dot(tri.v0 - org, tri.n) * inv;
+  return lane_and(ok, lane_and(t >= tmin, t <= tmax));
+}
+
 /// Moller and Trumbore 1997, "Fast, minimum storage ray-triangle intersection", written with the
 /// geometric normal n = e1 x e2 (as Embree does) so that a zero-area triangle, whose n is exactly the
 /// zero vector, has a zero denominator and never hits; nor does a ray lying in the triangle's plane.
@@ -85,29 +130,7 @@ template <class T>
 [[gnu::always_inline]] inline auto triangle_kernel(const Vec3T<T>& org, const Vec3T<T>& dir, T tmin, T tmax,
                                                    const Vec3T<T>& v0, const Vec3T<T>& v1, const Vec3T<T>& v2,
                                                    T& t, T& u, T& v) {
-  const Vec3T<T> e1 = v1 - v0;
-  const Vec3T<T> e2 = v2 - v0;
-  const Vec3T<T> n = cross(e1, e2);
-  const T den = dot(dir, n);
-  // A ray lying in the triangle's plane has den = 0 only in exact arithmetic; in floats it is rounding
-  // noise, and num/den then puts a "hit" anywhere along the ray, outside every box that holds the
-  // triangle. So den must exceed a bound on its rounding error (relative kCoplanarEps of the L1 product
-  // of |dir|, |e1|, |e2|), or the ray counts as parallel. The same rule for every structure keeps hits
-  // identical; such rays graze the plane within about 1e-5 radians (Embree's differ: verify calls them
-  // graze cases). Also rejects NaN.
-  auto ok = lane_abs(den) > parallel_bound(dir, e1, e2);
-  if (lane_none(ok)) return ok;
-  const T inv = T(1.0f) / den;
-  const Vec3T<T> to_origin = org - v0;
-  const Vec3T<T> c = cross(dir, to_origin);
-  u = dot(e2, c) * inv;
-  ok = lane_and(ok, u >= T(0.0f));
-  if (lane_none(ok)) return ok;
-  v = -dot(e1, c) * inv;
-  ok = lane_and(ok, lane_and(v >= T(0.0f), u + v <= T(1.0f)));
-  if (lane_none(ok)) return ok;
-  t = dot(v0 - org, n) * inv;
-  return lane_and(ok, lane_and(t >= tmin, t <= tmax));
+  return triangle_kernel_terms(org, dir, l1_norm(dir), tmin, tmax, triangle_terms(v0, v1, v2), t, u, v);
 }
 
 /// A glm vector as kernel coordinates.

@@ -1,5 +1,5 @@
-// Four triangles tested at once by the one kernel (triangle.h's triangle_kernel instantiated on four SSE
-// lanes), as Embree's Triangle4 leaves do. Every lane performs the scalar kernel's IEEE operations in the
+// Four triangles tested at once by the one kernel (triangle.h's triangle_kernel_terms instantiated on four
+// SSE lanes), as Embree's Triangle4 leaves do. Every lane performs the scalar kernel's IEEE operations in the
 // same order, so each lane's t, u, v and verdict are the bits intersect_triangle gives for that triangle.
 #pragma once
 
@@ -58,45 +58,56 @@ inline Mask4 lane_and(Mask4 a, Mask4 b) {
   return {_mm_and_ps(a.m, b.m)};
 }
 
-/// Four triangles in structure-of-arrays form: v[vertex][axis][lane]. Unused lanes hold a zero-area
-/// triangle (all vertices at the origin), which the kernel never reports.
-struct alignas(16) Triangle4 {
-  float v[3][3][4];
+/// Four triangles in structure-of-arrays form, as the kernel's triangle terms (triangle_terms: v0, e1, e2,
+/// n; row[term][axis][lane]) computed once when packing, as Embree's Triangle4 stores v0, e1, e2 and Ng: the
+/// same IEEE operations as the kernel makes at run time, so the same bits. Unused lanes hold a zero-area
+/// triangle (all terms zero), which the kernel never reports. 192 bytes: three cache lines.
+struct alignas(64) Triangle4 {
+  float row[4][3][4];
 
   /// Packs up to four triangles (the rest of the lanes are left zero-area).
   static Triangle4 pack(std::span<const Triangle> tris) {
     Triangle4 out{};
     for (size_t k = 0; k < tris.size() && k < 4; ++k) {
-      const vec3* corners[3] = {&tris[k].v0, &tris[k].v1, &tris[k].v2};
-      for (int c = 0; c < 3; ++c)
-        for (int a = 0; a < 3; ++a) out.v[c][a][k] = (*corners[c])[a];
+      const TriangleTerms<float> terms =
+          triangle_terms(to_lanes(tris[k].v0), to_lanes(tris[k].v1), to_lanes(tris[k].v2));
+      const Vec3T<float>* rows[4] = {&terms.v0, &terms.e1, &terms.e2, &terms.n};
+      for (int r = 0; r < 4; ++r) {
+        out.row[r][0][k] = rows[r]->x;
+        out.row[r][1][k] = rows[r]->y;
+        out.row[r][2][k] = rows[r]->z;
+      }
     }
     return out;
   }
-  /// One corner of all four lanes as kernel coordinates.
-  Vec3T<Lanes4> corner(int c) const {
-    return {Lanes4(_mm_load_ps(v[c][0])), Lanes4(_mm_load_ps(v[c][1])), Lanes4(_mm_load_ps(v[c][2]))};
+  /// One term of all four lanes as kernel coordinates.
+  [[gnu::always_inline]] Vec3T<Lanes4> term(int r) const {
+    return {Lanes4(_mm_load_ps(row[r][0])), Lanes4(_mm_load_ps(row[r][1])), Lanes4(_mm_load_ps(row[r][2]))};
   }
+  /// The four triangles' terms as the kernel takes them.
+  [[gnu::always_inline]] TriangleTerms<Lanes4> terms() const { return {term(0), term(1), term(2), term(3)}; }
 };
-static_assert(sizeof(Triangle4) == 144);
+static_assert(sizeof(Triangle4) == 192);
 
-/// A ray broadcast to four lanes (made once per ray).
+/// A ray broadcast to four lanes, with the L1 norm of its direction (made once per ray, as the kernel makes
+/// it).
 struct Ray4 {
   explicit Ray4(const Ray& r)
       : org{Lanes4(r.org.x), Lanes4(r.org.y), Lanes4(r.org.z)},
         dir{Lanes4(r.dir.x), Lanes4(r.dir.y), Lanes4(r.dir.z)},
+        l1_dir(l1_norm(to_lanes(r.dir))),
         tmin(r.tmin),
         tmax(r.tmax) {}
   Vec3T<Lanes4> org, dir;
-  Lanes4 tmin, tmax;
+  Lanes4 l1_dir, tmin, tmax;
 };
 
 /// The kernel on four triangles: returns the mask of lanes hit (bit k for lane k) and their t, u, v.
 [[gnu::always_inline]] inline unsigned intersect_triangle4(const Ray4& ray, const Triangle4& tris, float* t,
                                                            float* u, float* v) {
   Lanes4 lt, lu, lv;
-  const Mask4 hit = triangle_kernel<Lanes4>(ray.org, ray.dir, ray.tmin, ray.tmax, tris.corner(0),
-                                            tris.corner(1), tris.corner(2), lt, lu, lv);
+  const Mask4 hit =
+      triangle_kernel_terms<Lanes4>(ray.org, ray.dir, ray.l1_dir, ray.tmin, ray.tmax, tris.terms(), lt, lu, lv);
   const unsigned mask = unsigned(_mm_movemask_ps(hit.m));
   if (mask) {
     _mm_storeu_ps(t, lt.v);
