@@ -111,7 +111,9 @@ TEST(Bvh8, EnteredChildrenAreRankedFarthestFirst) {
       EXPECT_EQ(items[j].count, lane % 3);
       EXPECT_EQ(bits(items[j].t), bits(t[lane]));
       // nearest last (distances within the key's three dropped low bits count as ties)
-      if (j > 0) EXPECT_GE(bits(items[j - 1].t) & ~7u, bits(items[j].t) & ~7u) << trial;
+      if (j > 0) {
+        EXPECT_GE(bits(items[j - 1].t) & ~7u, bits(items[j].t) & ~7u) << trial;
+      }
     }
     EXPECT_EQ(seen, mask) << trial;  // every entered lane exactly once
   }
