@@ -1,5 +1,6 @@
-// The 8-wide BVH: its SIMD box test against the scalar one (and against the binary walk's arithmetic), the four-lane kernel against the scalar
-// kernel (bit for bit), the collapsed tree's invariants and its thread independence.
+// The 8-wide BVH: its SIMD box test against the scalar one (and against the binary walk's arithmetic), the
+// four-lane kernel against the scalar kernel (bit for bit), the collapsed tree's invariants and its thread
+// independence.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -48,9 +48,11 @@ Bvh8LeafBlocks pack_leaf_blocks(Bvh8NodeArray& wide, std::span<const uint32_t> o
   Bvh8LeafBlocks out;
   out.blocks.resize(first.back());
   out.ids.resize(4 * size_t(first.back()));
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) pack_node(wide[i], first[i], order, prims, out);
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide.size(), 1024),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i < r.end(); ++i)
+                        pack_node(wide[i], first[i], order, prims, out);
+                    });
   return out;
 }
 

@@ -84,7 +84,8 @@ struct Bvh8RayTest {
     __m256 tn = _mm256_set1_ps(-kInf);
     for (int a = 0; a < 3; ++a) tn = _mm256_max_ps(slab(n, near_row[a], org[a], inv[a]), tn);
     const __m256 shrink = _mm256_set1_ps(1.0f - kBoxEps), grow = _mm256_set1_ps(1.0f + kBoxEps);
-    tn = _mm256_mul_ps(tn, _mm256_blendv_ps(grow, shrink, _mm256_cmp_ps(tn, _mm256_setzero_ps(), _CMP_GT_OQ)));
+    tn =
+        _mm256_mul_ps(tn, _mm256_blendv_ps(grow, shrink, _mm256_cmp_ps(tn, _mm256_setzero_ps(), _CMP_GT_OQ)));
     return _mm256_max_ps(tn, tmin8);
   }
   /// General path: the widened far distance clipped to limit.
@@ -92,7 +93,8 @@ struct Bvh8RayTest {
     __m256 tf = _mm256_set1_ps(kInf);
     for (int a = 0; a < 3; ++a) tf = _mm256_min_ps(slab(n, far_row[a], org[a], inv[a]), tf);
     const __m256 shrink = _mm256_set1_ps(1.0f - kBoxEps), grow = _mm256_set1_ps(1.0f + kBoxEps);
-    tf = _mm256_mul_ps(tf, _mm256_blendv_ps(shrink, grow, _mm256_cmp_ps(tf, _mm256_setzero_ps(), _CMP_GT_OQ)));
+    tf =
+        _mm256_mul_ps(tf, _mm256_blendv_ps(shrink, grow, _mm256_cmp_ps(tf, _mm256_setzero_ps(), _CMP_GT_OQ)));
     return _mm256_min_ps(tf, _mm256_set1_ps(limit));
   }
 #endif
@@ -134,7 +136,7 @@ struct Bvh8RayTest {
   bool folded;                  ///< tmin >= 0: the widening is folded into inv_near and inv_far
   int near_row[3], far_row[3];  ///< bounds row of the near and far plane per axis
 #if defined(__AVX2__)
-  __m256 org[3], inv[3], tmin8;  ///< origin, reciprocal direction and tmin in every lane
+  __m256 org[3], inv[3], tmin8;    ///< origin, reciprocal direction and tmin in every lane
   __m256 inv_near[3], inv_far[3];  ///< reciprocals times 1 - kBoxEps and 1 + kBoxEps (folded path)
 #endif
 };
@@ -180,16 +182,15 @@ using Bvh8Stack = TraversalStack<Bvh8StackEntry, 7 * kBvhMaxDepth + 8>;
 [[gnu::always_inline]] inline int rank_entered_children(const Bvh8Node& n, unsigned mask, const float* t,
                                                         Bvh8StackEntry* items) {
 #if defined(__AVX2__)
-  const __m256i keys =
-      _mm256_or_si256(_mm256_and_si256(_mm256_load_si256(reinterpret_cast<const __m256i*>(t)),
-                                       _mm256_set1_epi32(~7)),
-                      _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m256i keys = _mm256_or_si256(
+      _mm256_and_si256(_mm256_load_si256(reinterpret_cast<const __m256i*>(t)), _mm256_set1_epi32(~7)),
+      _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
   alignas(32) int32_t key[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(key), keys);
   for (unsigned rest = mask; rest; rest &= rest - 1) {
     const int k = std::countr_zero(rest);
-    const unsigned farther = unsigned(_mm256_movemask_ps(
-        _mm256_castsi256_ps(_mm256_cmpgt_epi32(keys, _mm256_set1_epi32(key[k])))));
+    const unsigned farther = unsigned(
+        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(keys, _mm256_set1_epi32(key[k])))));
     items[std::popcount(farther & mask)] = {n.child[k], n.count[k], t[k]};
   }
   return std::popcount(mask);

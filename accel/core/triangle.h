@@ -86,7 +86,7 @@ struct TriangleTerms {
 /// The terms of triangle (v0, v1, v2).
 template <class T>
 [[gnu::always_inline]] inline TriangleTerms<T> triangle_terms(const Vec3T<T>& v0, const Vec3T<T>& v1,
-                                                             const Vec3T<T>& v2) {
+                                                              const Vec3T<T>& v2) {
   const Vec3T<T> e1 = v1 - v0;
   const Vec3T<T> e2 = v2 - v0;
   return {v0, e1, e2, cross(e1, e2)};

@@ -106,8 +106,8 @@ struct Ray4 {
 [[gnu::always_inline]] inline unsigned intersect_triangle4(const Ray4& ray, const Triangle4& tris, float* t,
                                                            float* u, float* v) {
   Lanes4 lt, lu, lv;
-  const Mask4 hit =
-      triangle_kernel_terms<Lanes4>(ray.org, ray.dir, ray.l1_dir, ray.tmin, ray.tmax, tris.terms(), lt, lu, lv);
+  const Mask4 hit = triangle_kernel_terms<Lanes4>(ray.org, ray.dir, ray.l1_dir, ray.tmin, ray.tmax,
+                                                  tris.terms(), lt, lu, lv);
   const unsigned mask = unsigned(_mm_movemask_ps(hit.m));
   if (mask) {
     _mm_storeu_ps(t, lt.v);
