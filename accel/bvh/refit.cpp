@@ -57,9 +57,9 @@ AABB refresh_leaf_blocks(Triangle4* blocks, const uint32_t* ids, uint32_t count,
     const uint32_t m = std::min(4u, count - s);
     for (uint32_t j = 0; j < m; ++j) {
       const Triangle& t = prims.triangle(ids[s + j]);
+      block.set_lane(int(j), t);  // the kernel's terms, as pack_leaf_blocks stores them
       const vec3* corners[3] = {&t.v0, &t.v1, &t.v2};
       for (int c = 0; c < 3; ++c) {
-        for (int a = 0; a < 3; ++a) block.v[c][a][j] = (*corners[c])[a];
         const __m128 p = _mm_setr_ps(corners[c]->x, corners[c]->y, corners[c]->z, 0.0f);
         lo = _mm_min_ps(lo, p);
         hi = _mm_max_ps(hi, p);

@@ -68,17 +68,18 @@ struct alignas(64) Triangle4 {
   /// Packs up to four triangles (the rest of the lanes are left zero-area).
   static Triangle4 pack(std::span<const Triangle> tris) {
     Triangle4 out{};
-    for (size_t k = 0; k < tris.size() && k < 4; ++k) {
-      const TriangleTerms<float> terms =
-          triangle_terms(to_lanes(tris[k].v0), to_lanes(tris[k].v1), to_lanes(tris[k].v2));
-      const Vec3T<float>* rows[4] = {&terms.v0, &terms.e1, &terms.e2, &terms.n};
-      for (int r = 0; r < 4; ++r) {
-        out.row[r][0][k] = rows[r]->x;
-        out.row[r][1][k] = rows[r]->y;
-        out.row[r][2][k] = rows[r]->z;
-      }
-    }
+    for (size_t k = 0; k < tris.size() && k < 4; ++k) out.set_lane(int(k), tris[k]);
     return out;
+  }
+  /// Writes the terms of triangle tri into lane k (the other lanes are unchanged).
+  void set_lane(int k, const Triangle& tri) {
+    const TriangleTerms<float> terms = triangle_terms(to_lanes(tri.v0), to_lanes(tri.v1), to_lanes(tri.v2));
+    const Vec3T<float>* rows[4] = {&terms.v0, &terms.e1, &terms.e2, &terms.n};
+    for (int r = 0; r < 4; ++r) {
+      row[r][0][k] = rows[r]->x;
+      row[r][1][k] = rows[r]->y;
+      row[r][2][k] = rows[r]->z;
+    }
   }
   /// One term of all four lanes as kernel coordinates.
   [[gnu::always_inline]] Vec3T<Lanes4> term(int r) const {
