@@ -74,7 +74,11 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
     const int depth_limit = config_.max_depth > 0 ? config_.max_depth : auto_depth_limit(ids.size());
     margin_ = ids.empty() ? 0.0f : insertion_margin(box_);
     BspBuffer out;
-    if (!ids.empty()) BspBuilder<P>(*prims_, config_, depth_limit, margin_).build(std::move(ids), box_, out);
+    if (!ids.empty()) {
+      BspBuilder<P> builder(*prims_, config_, depth_limit, margin_);
+      builder.build(std::move(ids), box_, out);
+      this->stats_.extra["budget_exhausted"] = builder.budget_exhausted();
+    }
     drop_empty_leaves(out.nodes);
     nodes_ = std::move(out.nodes);
     planes_ = std::move(out.payload);

@@ -2,7 +2,9 @@
 // Kammaje and Mora 2007): candidate planes (candidates.h) priced by the SAH over the node's convex cell
 // (cell.h), and a conservative partition (a primitive within the insertion margin of the plane goes to both
 // sides). Large nodes build their two subtrees in parallel, each into its own buffer, appended in a fixed
-// order (the same tree for any thread count).
+// order (the same tree for any thread count). The reference budget (build_with_budget, refine_rules.h) is
+// the safety net of the references: at most ref_budget per primitive, the tree unchanged on any input whose
+// tree stays under it.
 #pragma once
 
 #include <tbb/parallel_invoke.h>
@@ -15,6 +17,7 @@
 #include "accel/bsp/cell.h"
 #include "accel/bsp/config.h"
 #include "accel/bsp/node.h"
+#include "accel/common/refine_rules.h"
 #include "accel/core/clip.h"
 
 namespace ab {
@@ -29,8 +32,16 @@ class BspBuilder {
 
   /// Builds over ids (finite bounds) inside box into out.
   void build(std::vector<uint32_t> ids, const AABB& box, BspBuffer& out) const {
-    build_node(std::move(ids), ConvexCell::from_box(box), {}, Depth{}, out);
+    auto attempt = [&](RefLedger* ledger, RefBudget budget) {
+      ledger_ = ledger;
+      out = BspBuffer{};
+      build_node(std::vector<uint32_t>(ids), ConvexCell::from_box(box), {}, Depth{0, 0, budget}, out);
+    };
+    budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
+    ledger_ = nullptr;
   }
+  /// True when the tree was built with the reference budget (build_with_budget).
+  bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
   struct Choice {
@@ -88,13 +99,16 @@ class BspBuilder {
   /// Depth of a node: all levels, and the splits with primitives on both sides. A split with an empty side
   /// (cutting off empty space, often a corner of the cell by an oblique plane) never puts an entry on the
   /// traversal stack, so only the other splits count against max_depth; the levels have their own bound.
+  /// With the node's reference budget.
   struct Depth {
     int levels = 0, splits = 0;
+    RefBudget budget;
   };
   static constexpr int kEmptyCutLevels = 32;
 
   void build_node(std::vector<uint32_t>&& ids, const ConvexCell& cell, const std::vector<HalfSpace>& path,
                   Depth depth, BspBuffer& out) const {
+    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
     NodePrims np = gather(ids, cell, path);
     std::vector<uint32_t>().swap(ids);
     const size_t n = np.size();
@@ -103,10 +117,13 @@ class BspBuilder {
       best = find_plane(np, cell);
     std::vector<uint32_t> left, right;
     if (best.cost < config_.costs.leaf(n)) partition(np, best.plane, left, right);
-    if ((left.empty() && right.empty()) || (left.size() == n && right.size() == n)) {
+    if ((left.empty() && right.empty()) || (left.size() == n && right.size() == n) ||
+        !depth.budget.allows(left.size() + right.size())) {
+      if (ledger_) ledger_->add_leaf(n);
       out.nodes.push_back(out.make_leaf(np.ids));
       return;
     }
+    if (ledger_) ledger_->add_children(left.size() + right.size());
     np = NodePrims{};
     const ConvexCell lcell = cell.part(best.plane, true), rcell = cell.part(best.plane, false);
     std::vector<HalfSpace> lpath = path, rpath = path;
@@ -114,22 +131,25 @@ class BspBuilder {
       lpath.push_back({best.plane.n, best.plane.d + margin_});
       rpath.push_back({-best.plane.n, -best.plane.d + margin_});
     }
-    const Depth next{depth.levels + 1, depth.splits + int(!left.empty() && !right.empty())};
+    const int levels = depth.levels + 1, splits = depth.splits + int(!left.empty() && !right.empty());
+    const size_t all = left.size() + right.size();
+    const Depth lnext{levels, splits, depth.budget.share(left.size(), all)};
+    const Depth rnext{levels, splits, depth.budget.share(right.size(), all)};
     const size_t self = out.nodes.size();
     const uint32_t plane = uint32_t(out.payload.size());
     out.payload.push_back(best.plane);
     out.nodes.push_back(BspNode::leaf(0, 0));
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lpath, next, lb); },
-                           [&] { build_node(std::move(right), rcell, rpath, next, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lpath, lnext, lb); },
+                           [&] { build_node(std::move(right), rcell, rpath, rnext, rb); });
       out.append(lb);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lcell, lpath, next, out);
+      build_node(std::move(left), lcell, lpath, lnext, out);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rcell, rpath, next, out);
+      build_node(std::move(right), rcell, rpath, rnext, out);
     }
   }
 
@@ -300,8 +320,10 @@ class BspBuilder {
   static constexpr size_t kParallelMin = 256;
   const P& prims_;
   BspConfig config_;
-  int depth_limit_;  ///< resolved depth limit (> 0)
-  float margin_;     ///< insertion margin (from the root box)
+  int depth_limit_;                      ///< resolved depth limit (> 0)
+  float margin_;                         ///< insertion margin (from the root box)
+  mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
+  mutable bool budget_exhausted_ = false;
 };
 
 }  // namespace ab

@@ -17,6 +17,8 @@ struct BspConfig {
   int autopartition = 8;                       ///< triangles whose supporting planes are tried per node
   int max_depth = 0;                           ///< depth limit; 0: auto_depth_limit of the primitive count
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
+  double ref_budget =
+      32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
 
   /// Reads every field from params.
   static BspConfig read(Params& params) {
@@ -28,6 +30,7 @@ struct BspConfig {
     params.read("autopartition", c.autopartition, 0, 1024);
     params.read("max_depth", c.max_depth, 0, 100);
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
+    params.read("ref_budget", c.ref_budget, 1.0, 1e6);
     return c;
   }
 };

@@ -4,7 +4,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <utility>
 
 #include "accel/common/conservative_insertion.h"
 #include "accel/common/tree_stats.h"
@@ -17,6 +19,7 @@ GridConfig GridConfig::read(Params& params) {
   GridConfig c;
   params.read("lambda", c.lambda, 0.01, 100.0);
   params.read("max_cells", c.max_cells, 1, double(1ll << 31));
+  params.read("ref_budget", c.ref_budget, 1.0, 1e6);
   return c;
 }
 
@@ -254,16 +257,26 @@ struct BucketedPairs {
 
 }  // namespace
 
-GridCells build_grid_cells(const GridLayout& g, size_t n, const CellInserter& insert) {
+GridCells build_grid_cells(const GridLayout& g, size_t n, const CellInserter& insert, uint64_t max_refs) {
   GridCells cells;
   const size_t blocks = (n + kBlock - 1) / kBlock, cell_count = g.cells();
   std::vector<std::vector<uint64_t>> block_pairs(blocks);
-  // Pass 1: the (cell, id) pairs of each block of primitives.
+  // Pass 1: the (cell, id) pairs of each block of primitives, counted against max_refs every 64 of them.
+  std::atomic<uint64_t> refs{0};
   tbb::parallel_for(size_t(0), blocks, [&](size_t blk) {
     const size_t begin = blk * kBlock, end = std::min(n, begin + kBlock);
-    block_pairs[blk].reserve(4 * (end - begin));  // typical references per primitive: fewer regrowths
-    for (size_t i = begin; i < end; ++i) insert(uint32_t(i), block_pairs[blk]);
+    std::vector<uint64_t>& pairs = block_pairs[blk];
+    pairs.reserve(4 * (end - begin));  // typical references per primitive: fewer regrowths
+    size_t counted = 0;
+    for (size_t i = begin; i < end && refs.load(std::memory_order_relaxed) <= max_refs; ++i) {
+      insert(uint32_t(i), pairs);
+      if ((i - begin) % 64 == 63 || i + 1 == end) refs += pairs.size() - std::exchange(counted, pairs.size());
+    }
   });
+  if (refs.load() > max_refs) {
+    cells.over_budget = true;
+    return cells;
+  }
   // Pass 2: regroup by bucket of cells, keeping primitive order.
   const BucketedPairs bucketed(cell_count, block_pairs);
   std::vector<std::vector<uint64_t>>().swap(block_pairs);

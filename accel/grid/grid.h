@@ -5,6 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -25,6 +26,9 @@ namespace ab {
 struct GridConfig {
   double lambda = 1.0;  ///< density: about lambda * cbrt(N) cells per axis for a cube (lambda^3 N cells)
   uint64_t max_cells = 1ull << 24;  ///< cap on the number of cells
+  /// The cells hold at most this many references per primitive: a grid that would hold more is built
+  /// again with lambda halved (an eighth of the cells) until it fits.
+  double ref_budget = 32.0;
 
   /// Reads every field from params.
   static GridConfig read(Params& params);
@@ -66,6 +70,7 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
 struct GridCells {
   std::vector<uint32_t> offsets;  ///< cells + 1 row starts
   std::vector<uint32_t> ids;      ///< the cells' primitive ids, cell after cell
+  bool over_budget = false;       ///< the references passed build_grid_cells' max_refs (nothing built)
 };
 
 /// Appends to `out` the cells primitive `id` goes into, each as (cell index << 32) | id, in ascending
@@ -91,8 +96,11 @@ CellInserter triangle_inserter(const GridLayout& layout, std::span<const Triangl
 float insertion_margin(const GridLayout& layout);
 
 /// Two-pass insertion of primitives [0, n) (collect the (cell, id) pairs per block of primitives on TBB,
-/// then count and fill): deterministic for any thread count, the ids of every cell ascending.
-GridCells build_grid_cells(const GridLayout& layout, size_t n, const CellInserter& insert);
+/// then count and fill): deterministic for any thread count, the ids of every cell ascending. When the
+/// references would pass max_refs, it stops early and returns no cells with over_budget set (the count
+/// only grows, so that depends on the grid alone, not on the threads).
+GridCells build_grid_cells(const GridLayout& layout, size_t n, const CellInserter& insert,
+                           uint64_t max_refs = UINT64_MAX);
 
 /// A small direct-mapped per-ray mailbox (Amanatides and Woo 1987, section 4): remembers recently tested
 /// ids so a primitive spanning several cells is tested once. It lives on the tracing thread's stack, so it
@@ -198,21 +206,38 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   }
 
  protected:
+  /// The reference budget (GridConfig::ref_budget): the grid of lambda, or of lambda halved until its
+  /// references fit (at lambda^3 N < 1 cell a grid of one cell holds N references, which always fits).
   void do_build() override {
     const size_t n = prims_->size();
-    layout_ = make_grid_layout(prims_->bounds(), n, config_);
+    const uint64_t max_refs = uint64_t(std::min(config_.ref_budget * double(n), 1e19));
+    GridConfig config = config_;
+    for (;;) {
+      layout_ = make_grid_layout(prims_->bounds(), n, config);
+      insert_all(n, max_refs);
+      if (!cells_.over_budget) break;
+      config.lambda *= 0.5;
+    }
+    this->stats_.extra["budget_exhausted"] = config.lambda != config_.lambda;
+    this->stats_.extra["budget_lambda"] = config.lambda;
+  }
+
+  /// Fills the cells of layout_.
+  void insert_all(size_t n, uint64_t max_refs) {
+    if (layout_.cells() == 1) max_refs = UINT64_MAX;  // one cell: N references, within any budget
     if constexpr (std::is_same_v<P, TrianglePrims>) {
-      cells_ = build_grid_cells(layout_, n, triangle_inserter(layout_, prims_->triangles()));
+      cells_ = build_grid_cells(layout_, n, triangle_inserter(layout_, prims_->triangles()), max_refs);
     } else {
       std::vector<AABB> boxes(n);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) boxes[i] = prims_->bounds(i);
       });
       const P& prims = *prims_;
-      cells_ =
-          build_grid_cells(layout_, n, box_test_inserter(layout_, boxes, [&prims](uint32_t i, const AABB& b) {
-                             return prims.overlaps(i, b);
-                           }));
+      cells_ = build_grid_cells(
+          layout_, n,
+          box_test_inserter(layout_, boxes,
+                            [&prims](uint32_t i, const AABB& b) { return prims.overlaps(i, b); }),
+          max_refs);
     }
   }
 

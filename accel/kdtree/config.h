@@ -24,7 +24,8 @@ struct KdMedianConfig {
   int bad_refines = 3;  ///< a node whose split is the bad_refines-th bad one on its path is a leaf (pbrt-v3)
   /// pbrt-v3's cost model of the bad-refine rule (KdTreeAccel: traversalCost 1, isectCost 80).
   SahCosts costs{.traversal = 1.0f, .intersection = 80.0f, .empty_bonus = 0.0f};
-  double ref_budget = 64.0;  ///< the leaves hold at most this many references per primitive (RefBudget)
+  double ref_budget =
+      32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
 
   /// Reads every field from params.
   static KdMedianConfig read(Params& params) {
@@ -48,6 +49,11 @@ struct KdSahConfig {
   SahCosts costs{.traversal = 1.0f, .intersection = 1.5f, .empty_bonus = 0.2f};
   int max_depth = 0;                           ///< depth limit; 0: auto_depth_limit of the primitive count
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
+  /// A node the cost model makes a leaf splits at its cheapest plane anyway while it holds more than this
+  /// many primitives and each child fewer (KdSahBuilder; 0: never).
+  size_t max_leaf = 64;
+  double ref_budget =
+      32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
 
   /// Reads every field from params.
   static KdSahConfig read(Params& params) {
@@ -57,6 +63,8 @@ struct KdSahConfig {
     params.read("empty_bonus", c.costs.empty_bonus, 0.0, 0.99);
     params.read("max_depth", c.max_depth, 0, 100);
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
+    params.read("max_leaf", c.max_leaf, 0, size_t(1) << 30);
+    params.read("ref_budget", c.ref_budget, 1.0, 1e6);
     return c;
   }
 };

@@ -86,7 +86,9 @@ class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
     KdBuffer out;
     if (!ids.empty()) {
       if constexpr (M == KdMethod::kSah) {
-        KdSahBuilder<P>(*prims_, config_, depth_limit).build(ids, box_, out);
+        KdSahBuilder<P> builder(*prims_, config_, depth_limit);
+        builder.build(ids, box_, out);
+        this->stats_.extra["budget_exhausted"] = builder.budget_exhausted();
       } else {
         KdMedianBuilder<P> builder(*prims_, config_, depth_limit);
         builder.build(ids, box_, out);

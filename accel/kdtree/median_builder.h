@@ -8,7 +8,8 @@
 // - pbrt-v3's bad refines (Pharr, Jakob and Humphreys 2016, 4.4.2): a split is bad when its surface-area
 //   cost estimate Ct + Ci (pL nL + pR nR) is not below the leaf's Ci n; the bad_refines-th bad split on a
 //   path makes a leaf instead;
-// - the reference budget (refine_rules.h) as a safety net: at most ref_budget references per primitive.
+// - the reference budget (build_with_budget, refine_rules.h) as a safety net: at most ref_budget
+//   references per primitive, the tree unchanged on any input whose tree stays under it.
 #pragma once
 
 #include <tbb/parallel_invoke.h>
@@ -39,11 +40,17 @@ class KdMedianBuilder {
 
   /// Builds the tree over the primitives ids (finite bounds) inside box into out.
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
-    std::vector<Ref> refs(ids.size());
-    for (size_t i = 0; i < ids.size(); ++i) refs[i] = {ids[i], prims_.clipped_bounds(ids[i], box)};
-    build_node(std::move(refs), box, {0, 0, {config_.ref_budget * double(ids.size())}}, out);
+    auto attempt = [&](RefLedger* ledger, RefBudget budget) {
+      ledger_ = ledger;
+      out = KdBuffer{};
+      std::vector<Ref> refs(ids.size());
+      for (size_t i = 0; i < ids.size(); ++i) refs[i] = {ids[i], prims_.clipped_bounds(ids[i], box)};
+      build_node(std::move(refs), box, {0, 0, budget}, out);
+    };
+    budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
+    ledger_ = nullptr;
   }
-  /// True when some node became a leaf for the reference budget.
+  /// True when the tree was built with the reference budget (build_with_budget).
   bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
@@ -65,12 +72,11 @@ class KdMedianBuilder {
         c.intersection *
             (area > 0.0 ? (lbox.area() * double(nl) + rbox.area() * double(nr)) / area : double(nl + nr));
     if (too_many_bad_refines(split >= c.intersection * double(n), config_.bad_refines, path.bad)) return true;
-    if (path.budget.allows(nl + nr)) return false;
-    budget_exhausted_ = true;
-    return true;
+    return !path.budget.allows(nl + nr);
   }
 
   void build_node(std::vector<Ref>&& refs, const AABB& box, Path path, KdBuffer& out) const {
+    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
     const size_t n = refs.size();
     const int depth = path.depth;
     int axis = config_.axis == KdAxisRule::kCycle ? depth % 3 : box.longest_axis();
@@ -90,6 +96,7 @@ class KdMedianBuilder {
     }
     std::vector<Ref>().swap(refs);
     const size_t all = left.size() + right.size();
+    if (ledger_) ledger_->add_children(all);
     const Path lp{depth + 1, path.bad, path.budget.share(left.size(), all)};
     const Path rp{depth + 1, path.bad, path.budget.share(right.size(), all)};
     const size_t self = out.nodes.size();
@@ -134,7 +141,8 @@ class KdMedianBuilder {
     }
   }
 
-  static void make_leaf(const std::vector<Ref>& refs, KdBuffer& out) {
+  void make_leaf(const std::vector<Ref>& refs, KdBuffer& out) const {
+    if (ledger_) ledger_->add_leaf(refs.size());
     std::vector<uint32_t> ids(refs.size());
     for (size_t i = 0; i < refs.size(); ++i) ids[i] = refs[i].id;
     std::sort(ids.begin(), ids.end());
@@ -146,7 +154,8 @@ class KdMedianBuilder {
   const P& prims_;
   KdMedianConfig config_;
   int depth_limit_;
-  mutable BudgetFlag budget_exhausted_{false};
+  mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
+  mutable bool budget_exhausted_ = false;
 };
 
 }  // namespace ab

@@ -5,8 +5,15 @@
 // events in order; straddling ones are clipped to each child box, "perfect splits", and their few new
 // events sorted and merged). Cost model (SahCosts, sah.h): C = lambda (Ct + Ci (P_L N_L + P_R N_R)) with
 // lambda = 1 - bonus when one side is empty; planar primitives are counted on the cheaper side; a node
-// becomes a leaf when no plane beats Ci N. The upper levels build in parallel on TBB; the tree is the same
-// for any thread count (every subtree is built deterministically and spliced in a fixed order).
+// becomes a leaf when no plane beats Ci N, unless it holds more than max_leaf primitives: then it splits at
+// its cheapest plane anyway when both children hold fewer than it. The SAH assumes rays that never stop
+// (MacDonald and Booth 1990), so on large overlapping triangles, which every plane mostly duplicates, it
+// prices every split above the leaf and makes one leaf of them all; a ray stops at its first hit, though,
+// and smaller cells front to back let it stop after testing a few of them. The reference budget
+// (build_with_budget, refine_rules.h) bounds those splits: at most ref_budget references per primitive,
+// the tree unchanged on any input whose tree stays under it. The upper levels build in parallel on TBB; the
+// tree is the same for any thread count (every subtree is built deterministically and spliced in a fixed
+// order).
 //
 // Robustness without duplicating every primitive that touches a plane: the traversal widens the two
 // halves of the ray interval around t_split (split_plane.h), so a hit on the plane itself (flat geometry
@@ -19,11 +26,13 @@
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "accel/common/conservative_insertion.h"
+#include "accel/common/refine_rules.h"
 #include "accel/common/sah.h"
 #include "accel/kdtree/config.h"
 #include "accel/kdtree/node.h"
@@ -91,23 +100,38 @@ struct KdAxisAreas {
   }
 };
 
+/// The cheapest plane of a node, and the cheapest one that leaves fewer than all n primitives on each side
+/// (the plane of a max_leaf split, which must make progress).
+struct KdSahChoice {
+  KdSahPlane best;      ///< cheapest plane
+  KdSahPlane progress;  ///< cheapest plane with both sides smaller than the node
+};
+
+/// Keeps plane (a, pos, cost c, planar side, counts) in best when cheaper.
+inline void keep_cheaper(KdSahPlane& best, int a, float pos, float c, bool planar_left, uint32_t nl,
+                         uint32_t nr) {
+  if (c < best.cost) best = {a, pos, c, planar_left, nl, nr};
+}
+
 /// Evaluates plane `pos` on axis a with the paper's counts, both placements of planar primitives. The
 /// areas are relative to the node's (the probabilities P_L, P_R), so the cost model is called with a
 /// parent area of 1.
 inline void evaluate_kd_plane(const SahCosts& costs, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
-                              uint32_t np, uint32_t nr, KdSahPlane& best) {
+                              uint32_t np, uint32_t nr, uint32_t n, KdSahChoice& choice) {
   const float pl = (ar.cap + ar.side * (pos - ar.lo)) * ar.inv_area;
   const float pr = (ar.cap + ar.side * (ar.hi - pos)) * ar.inv_area;
   const float cl = costs.split(1.0f, pl, nl + np, pr, nr);
   const float cr = np ? costs.split(1.0f, pl, nl, pr, nr + np) : cl;
-  const float c = std::min(cl, cr);
-  if (c < best.cost) best = {a, pos, c, cl <= cr, cl <= cr ? nl + np : nl, cl <= cr ? nr : nr + np};
+  keep_cheaper(choice.best, a, pos, std::min(cl, cr), cl <= cr, cl <= cr ? nl + np : nl,
+               cl <= cr ? nr : nr + np);
+  if (nl + np < n && nr < n) keep_cheaper(choice.progress, a, pos, cl, true, nl + np, nr);
+  if (np && nl < n && nr + np < n) keep_cheaper(choice.progress, a, pos, cr, false, nl, nr + np);
 }
 
 /// Finds the cheapest plane strictly inside the node box by one sweep per axis (Wald and Havran 2006,
 /// algorithm 4).
-inline KdSahPlane find_kd_sah_plane(const SahCosts& costs, const KdEventNode& node) {
-  KdSahPlane best;
+inline KdSahChoice find_kd_sah_plane(const SahCosts& costs, const KdEventNode& node) {
+  KdSahChoice best;
   if (!(node.box.area() > 0.0f)) return best;
   const uint32_t n = uint32_t(node.ids.size());
   for (int a = 0; a < 3; ++a) {
@@ -121,7 +145,8 @@ inline KdSahPlane find_kd_sah_plane(const SahCosts& costs, const KdEventNode& no
       for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kPlanar; ++i) ++planars;
       for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kStart; ++i) ++starts;
       nr -= planars + ends;
-      if (p > node.box.lo[a] && p < node.box.hi[a]) evaluate_kd_plane(costs, ar, a, p, nl, planars, nr, best);
+      if (p > node.box.lo[a] && p < node.box.hi[a])
+        evaluate_kd_plane(costs, ar, a, p, nl, planars, nr, n, best);
       nl += starts + planars;
     }
   }
@@ -134,13 +159,20 @@ class KdSahBuilder {
  public:
   /// Builder over prims with the tree's configuration and its resolved depth limit (> 0).
   KdSahBuilder(const P& prims, const KdSahConfig& config, int depth_limit)
-      : prims_(prims), costs_(config.costs), depth_limit_(depth_limit) {}
+      : prims_(prims), config_(config), costs_(config.costs), depth_limit_(depth_limit) {}
 
   /// Builds the tree over the primitives `ids` (finite bounds) inside `box` into out.
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
-    KdEventNode root = make_root(ids, box);
-    build_node(std::move(root), 0, out);
+    auto attempt = [&](RefLedger* ledger, RefBudget budget) {
+      ledger_ = ledger;
+      out = KdBuffer{};
+      build_node(make_root(ids, box), {0, budget}, out);
+    };
+    budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
+    ledger_ = nullptr;
   }
+  /// True when the tree was built with the reference budget (build_with_budget).
+  bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
   KdEventNode make_root(const std::vector<uint32_t>& ids, const AABB& box) const {
@@ -175,35 +207,62 @@ class KdSahBuilder {
     return root;
   }
 
-  void build_node(KdEventNode&& node, int depth, KdBuffer& out) const {
+  /// Where a node sits: its depth and its reference budget.
+  struct Path {
+    int depth;
+    RefBudget budget;
+  };
+
+  /// Appends a leaf of ids.
+  void make_leaf(const std::vector<uint32_t>& ids, KdBuffer& out) const {
+    if (ledger_) ledger_->add_leaf(ids.size());
+    out.nodes.push_back(out.make_leaf(ids));
+  }
+
+  void build_node(KdEventNode&& node, Path path, KdBuffer& out) const {
+    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
     const size_t n = node.ids.size();
-    KdSahPlane plane;
-    if (n > 0 && depth < depth_limit_) plane = find_kd_sah_plane(costs_, node);
-    if (plane.axis < 0 || plane.cost >= costs_.leaf(n)) {
-      out.nodes.push_back(out.make_leaf(node.ids));
-      return;
-    }
+    KdSahChoice choice;
+    if (n > 0 && path.depth < depth_limit_) choice = find_kd_sah_plane(costs_, node);
+    const bool forced = choice.best.axis >= 0 && choice.best.cost >= costs_.leaf(n);  // max_leaf's split
+    if (choice.best.axis < 0 || (forced && (config_.max_leaf == 0 || n <= config_.max_leaf)))
+      return make_leaf(node.ids, out);
+    const KdSahPlane& plane = forced ? choice.progress : choice.best;
+    if (plane.axis < 0) return make_leaf(node.ids, out);
     const float split = plane.pos;
     KdEventNode left, right;
     partition(std::move(node), plane.axis, split, plane.planar_left, left, right);
-    if (left.ids.size() == n && right.ids.size() == n) {
-      out.nodes.push_back(out.make_leaf(left.ids));
-      return;
+    const size_t nl = left.ids.size(), nr = right.ids.size();
+    if ((nl == n && nr == n) || (forced && std::max(nl, nr) == n) || !path.budget.allows(nl + nr)) {
+      std::vector<uint32_t> ids = std::move(left.ids);  // all n when nl == n
+      if (nl != n) ids = merged_ids(ids, right.ids);
+      return make_leaf(ids, out);
     }
+    if (ledger_) ledger_->add_children(nl + nr);
+    const Path lp{path.depth + 1, path.budget.share(nl, nl + nr)};
+    const Path rp{path.depth + 1, path.budget.share(nr, nl + nr)};
     const size_t self = out.nodes.size();
     out.nodes.push_back(KdNode::leaf(0, 0));
     if (n >= kParallelMin) {
       KdBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), depth + 1, lb); },
-                           [&] { build_node(std::move(right), depth + 1, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lp, lb); },
+                           [&] { build_node(std::move(right), rp, rb); });
       out.append(lb);
       out.nodes[self] = KdNode::interior(plane.axis, split, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), depth + 1, out);
+      build_node(std::move(left), lp, out);
       out.nodes[self] = KdNode::interior(plane.axis, split, uint32_t(out.nodes.size()));
-      build_node(std::move(right), depth + 1, out);
+      build_node(std::move(right), rp, out);
     }
+  }
+
+  /// The node's primitives from its two children's lists (each in the node's order): sorted, once each.
+  static std::vector<uint32_t> merged_ids(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+    std::vector<uint32_t> out(a.size() + b.size());
+    std::merge(a.begin(), a.end(), b.begin(), b.end(), out.begin());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
   }
 
   /// Splits node's primitives and events at `split` on axis a into left and right (linear time).
@@ -283,8 +342,11 @@ class KdSahBuilder {
   /// Nodes at least this large build their children in parallel.
   static constexpr size_t kParallelMin = 16384;
   const P& prims_;
+  KdSahConfig config_;
   SahCosts costs_;
   int depth_limit_;
+  mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
+  mutable bool budget_exhausted_ = false;
 };
 
 }  // namespace ab

@@ -7,7 +7,8 @@
 //   of its parent's area, so it is bad when the children hold at least 4x the node's references; the
 //   bad_refines-th bad one on a path makes a leaf instead (large overlapping triangles, copied into most
 //   children, stop after a few levels);
-// - the reference budget (refine_rules.h) as a safety net: at most ref_budget references per primitive.
+// - the reference budget (build_with_budget, refine_rules.h) as a safety net: at most ref_budget
+//   references per primitive, the tree unchanged on any input whose tree stays under it.
 // Primitives are inserted by exact primitive/box overlap against the child boxes grown by the insertion
 // margin (inflate_for_insertion, clip.h), so a primitive touching a cell or within rounding of its boundary
 // is in every such cell. Large nodes build their eight subtrees in parallel, each into its own buffer,
@@ -19,12 +20,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "accel/common/refine_rules.h"
 #include "accel/core/clip.h"
+#include "accel/core/primitives.h"
 #include "accel/octree/config.h"
 #include "accel/octree/node.h"
+#include "accel/octree/octant_split.h"
 
 namespace ab {
 
@@ -55,11 +59,20 @@ class OctreeBuilder {
 
   /// Builds the tree over the primitives ids (finite bounds) inside the cube `box` into out (root: node 0).
   void build(std::vector<uint32_t>&& ids, const AABB& box, OctBuffer& out) const {
-    out.nodes.push_back(OctNode::leaf(0, 0));
-    const RefBudget budget{config_.ref_budget * double(ids.size())};
-    if (!ids.empty()) build_node(std::move(ids), box, {0, 0, budget}, 0, out);
+    if (ids.empty()) {
+      out.nodes.push_back(OctNode::leaf(0, 0));
+      return;
+    }
+    auto attempt = [&](RefLedger* ledger, RefBudget budget) {
+      ledger_ = ledger;
+      out = OctBuffer{};
+      out.nodes.push_back(OctNode::leaf(0, 0));
+      build_node(std::vector<uint32_t>(ids), box, {0, 0, budget}, 0, out);
+    };
+    budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
+    ledger_ = nullptr;
   }
-  /// True when some node became a leaf for the reference budget.
+  /// True when the tree was built with the reference budget (build_with_budget).
   bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
@@ -79,22 +92,23 @@ class OctreeBuilder {
       refs += k.size();
     }
     if (!progress || too_many_bad_refines(refs >= 4 * n, config_.bad_refines, path.bad)) return true;
-    if (path.budget.allows(refs)) return false;
-    budget_exhausted_ = true;
-    return true;
+    return !path.budget.allows(refs);
   }
 
   /// Builds node `self` (already allocated) over ids inside box.
   void build_node(std::vector<uint32_t>&& ids, const AABB& box, Path path, uint32_t self,
                   OctBuffer& out) const {
+    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
     std::array<std::vector<uint32_t>, 8> kids;
     if (ids.size() > config_.leaf_size && path.depth < depth_limit_) distribute(ids, box, kids);
     if (stop(kids, ids.size(), path)) {
+      if (ledger_) ledger_->add_leaf(ids.size());
       out.nodes[self] = out.make_leaf(ids);
       return;
     }
     size_t refs = 0;
     for (const auto& k : kids) refs += k.size();
+    if (ledger_) ledger_->add_children(refs);
     std::array<Path, 8> sub;
     for (int k = 0; k < 8; ++k) sub[k] = {path.depth + 1, path.bad, path.budget.share(kids[k].size(), refs)};
     const size_t n = ids.size();
@@ -114,14 +128,24 @@ class OctreeBuilder {
     for (int k = 0; k < 8; ++k) out.splice(subs[k], first + k);
   }
 
-  /// Exact overlap of every primitive with the eight (grown) child boxes.
+  /// Every primitive into each child whose grown box it overlaps: triangles by the one-pass octant split
+  /// (octant_split.h; the exact test when a clip overflows), other primitives by the exact test.
   void distribute(const std::vector<uint32_t>& ids, const AABB& box,
                   std::array<std::vector<uint32_t>, 8>& kids) const {
-    for (int k = 0; k < 8; ++k) {
-      const AABB grown = inflate_for_insertion(octant_box(box, k));
-      for (uint32_t i : ids)
-        if (prims_.overlaps(i, grown)) kids[k].push_back(i);
+    std::array<AABB, 8> child, grown;
+    for (int k = 0; k < 8; ++k) child[k] = octant_box(box, k), grown[k] = inflate_for_insertion(child[k]);
+    if constexpr (std::is_same_v<P, TrianglePrims>) {
+      const OctantFrame frame(box, child, grown);
+      for (uint32_t i : ids) {
+        const int bits = triangle_octants(prims_.triangle(i), frame);
+        for (int k = 0; k < 8; ++k)
+          if (bits < 0 ? prims_.overlaps(i, grown[k]) : ((bits >> k) & 1)) kids[k].push_back(i);
+      }
+      return;
     }
+    for (int k = 0; k < 8; ++k)
+      for (uint32_t i : ids)
+        if (prims_.overlaps(i, grown[k])) kids[k].push_back(i);
   }
 
   /// Nodes at least this large build their children in parallel.
@@ -129,7 +153,8 @@ class OctreeBuilder {
   const P& prims_;
   OctreeConfig config_;
   int depth_limit_;
-  mutable BudgetFlag budget_exhausted_{false};
+  mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
+  mutable bool budget_exhausted_ = false;
 };
 
 }  // namespace ab

@@ -15,7 +15,8 @@ struct OctreeConfig {
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   bool auto_depth = true;  ///< depth limit max(max_depth, auto_octree_depth_limit(N)), at most kMaxDepth
   int bad_refines = 3;  ///< a node whose split is the bad_refines-th bad one on its path is a leaf (pbrt-v3)
-  double ref_budget = 64.0;  ///< the leaves hold at most this many references per primitive (RefBudget)
+  double ref_budget =
+      32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
 
   /// The deepest level traversal supports (its stack).
   static constexpr int kMaxDepth = 20;
