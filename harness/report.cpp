@@ -50,6 +50,8 @@ const std::vector<std::string>& csv_columns() {
                                                 "build_seconds_max",
                                                 "bytes",
                                                 "bytes_per_triangle",
+                                                "peak_bytes",
+                                                "peak_bytes_per_triangle",
                                                 "nodes",
                                                 "leaves",
                                                 "max_depth",

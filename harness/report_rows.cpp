@@ -101,6 +101,8 @@ json configuration_fields(const std::string& scene, const Target& target, const 
             {"build_seconds_max", build.max},
             {"bytes", s.bytes},
             {"bytes_per_triangle", double(s.bytes) / tri},
+            {"peak_bytes", s.peak_bytes},
+            {"peak_bytes_per_triangle", double(s.peak_bytes) / tri},
             {"nodes", s.nodes},
             {"leaves", s.leaves},
             {"max_depth", s.max_depth},
@@ -117,6 +119,7 @@ json build_entry(const std::string& scene, const Target& target, const AccelSpec
   json j = configuration_identity(scene, target, spec, accel);
   j.update({{"build_seconds", timing_json(build)},
             {"bytes_per_triangle", double(s.bytes) / tri},
+            {"peak_bytes_per_triangle", double(s.peak_bytes) / tri},
             {"stats", to_json(s)},
             {"verification", json::array()}});
   return j;

@@ -16,6 +16,8 @@ nlohmann::json to_json(const BuildStats& s) {
           {"references_per_primitive", s.references_per_primitive()},
           {"bytes", s.bytes},
           {"bytes_per_primitive", s.bytes_per_primitive()},
+          {"peak_bytes", s.peak_bytes},
+          {"peak_bytes_per_primitive", s.peak_bytes_per_primitive()},
           {"sah_cost", s.sah_cost},
           {"epo", s.epo >= 0 ? nlohmann::json(s.epo) : nlohmann::json()},
           {"leaf_size_histogram", hist},

@@ -36,6 +36,7 @@ struct BuildStats {
   double mean_leaf_depth = 0.0;  ///< mean depth over leaves
   uint64_t references = 0;       ///< primitive references stored in leaves or cells
   uint64_t bytes = 0;            ///< memory of the structure itself (not the input mesh)
+  uint64_t peak_bytes = 0;       ///< the build's high-water mark of heap memory above its start (memory.h)
   double sah_cost = 0.0;         ///< SAH cost, costs 1 and 1, normalized by the root's area (0: not computed)
   double epo = -1.0;  ///< end-point overlap (accel/common/epo.h), costs 1 and 1 (< 0: not computed)
   std::map<uint32_t, uint64_t> leaf_size_histogram;  ///< primitives per leaf -> number of leaves
@@ -47,6 +48,10 @@ struct BuildStats {
   }
   /// Bytes per primitive.
   double bytes_per_primitive() const { return primitives ? double(bytes) / double(primitives) : 0.0; }
+  /// Peak build bytes per primitive.
+  double peak_bytes_per_primitive() const {
+    return primitives ? double(peak_bytes) / double(primitives) : 0.0;
+  }
   /// Adds one leaf of `size` primitives at `depth` to the counts (nodes are counted by the caller).
   void add_leaf(uint32_t size, uint32_t depth) {
     ++leaves;

@@ -10,9 +10,13 @@ namespace ab {
 
 namespace {
 std::atomic<int64_t> g_embree_bytes{0};
+std::atomic<int64_t> g_embree_peak{0};
 
 bool monitor(void*, ssize_t bytes, bool) {
-  g_embree_bytes += bytes;
+  const int64_t now = g_embree_bytes += bytes;
+  int64_t peak = g_embree_peak.load();
+  while (now > peak && !g_embree_peak.compare_exchange_weak(peak, now)) {
+  }
   return true;
 }
 }  // namespace
@@ -29,6 +33,16 @@ RTCDevice embree_device() {
 
 int64_t embree_bytes_in_use() {
   return g_embree_bytes.load();
+}
+
+int64_t embree_restart_peak() {
+  const int64_t now = g_embree_bytes.load();
+  g_embree_peak.store(now);
+  return now;
+}
+
+int64_t embree_peak_bytes() {
+  return g_embree_peak.load();
 }
 
 EmbreeConfig EmbreeConfig::read(Params& params) {

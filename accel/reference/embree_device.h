@@ -21,6 +21,10 @@ inline constexpr const char* kEmbreeName = "embree";
 RTCDevice embree_device();
 /// Bytes Embree currently holds (from the device's memory monitor).
 int64_t embree_bytes_in_use();
+/// Restarts the high-water mark of the memory monitor at the bytes Embree holds now, and returns them.
+int64_t embree_restart_peak();
+/// The most bytes Embree held since the last embree_restart_peak().
+int64_t embree_peak_bytes();
 
 /// Embree's configuration: the build quality (RTC_BUILD_QUALITY_*), medium by default for meshes and scenes
 /// alike (the reference every ratio_to_embree is measured against).
