@@ -51,7 +51,7 @@ inline nlohmann::json without_timings(nlohmann::json value) {
     const std::string& k = it.key();
     const bool timing = k.find("seconds") != std::string::npos ||
                         k.find("rays_per_second") != std::string::npos || k == "ratio_to_embree" ||
-                        k == "iterations" || k == "extra";
+                        k == "iterations" || k == "extra" || k.find("peak_bytes") != std::string::npos;
     if (timing)
       it = value.erase(it);
     else
