@@ -36,32 +36,6 @@ std::shared_ptr<const Scene> probe_scene() {
 
 }  // namespace
 
-const std::vector<UpdateStrategy>& all_update_strategies() {
-  static const std::vector<UpdateStrategy> all{UpdateStrategy::kRebuild, UpdateStrategy::kRefit,
-                                               UpdateStrategy::kAdaptive, UpdateStrategy::kTopLevel};
-  return all;
-}
-
-std::string strategy_name(UpdateStrategy strategy) {
-  switch (strategy) {
-    case UpdateStrategy::kRebuild:
-      return "rebuild";
-    case UpdateStrategy::kRefit:
-      return "refit";
-    case UpdateStrategy::kAdaptive:
-      return "adaptive";
-    case UpdateStrategy::kTopLevel:
-      return "top-level";
-  }
-  return "rebuild";
-}
-
-UpdateStrategy parse_strategy(const std::string& name) {
-  for (UpdateStrategy s : all_update_strategies())
-    if (strategy_name(s) == name) return s;
-  throw ParamError("strategy '" + name + "' is not one of rebuild, refit, adaptive, top-level");
-}
-
 double update_sah_cost(const Accelerator& accel) {
   const nlohmann::json stats = to_json(accel.stats());
   const nlohmann::json& extra = stats["extra"];
