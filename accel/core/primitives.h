@@ -29,14 +29,9 @@ namespace ab {
 /// The triangles of a mesh, with their vertices copied out in id order for fast access.
 class TrianglePrims {
  public:
-  /// Copies the triangles of mesh (which is kept alive for adapters that need the indexed form).
-  explicit TrianglePrims(std::shared_ptr<const Mesh> mesh) : mesh_(std::move(mesh)) {
-    tris_.resize(mesh_->size());
-    for (size_t i = 0; i < tris_.size(); ++i) {
-      tris_[i] = mesh_->triangle(i);
-      bounds_.extend(tris_[i].bounds());
-    }
-  }
+  /// Copies the triangles of mesh (which is kept alive for adapters that need the indexed form), in
+  /// parallel (every frame of a refitted animation pays this copy); the same result on any thread count.
+  explicit TrianglePrims(std::shared_ptr<const Mesh> mesh);
 
   /// Number of triangles.
   size_t size() const { return tris_.size(); }
