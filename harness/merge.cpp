@@ -8,6 +8,7 @@
 
 #include "accel/core/error.h"
 #include "datasets/atomic_file.h"
+#include "harness/frames.h"
 #include "harness/report.h"
 
 namespace ab {
@@ -179,6 +180,7 @@ json merged_report(const std::vector<ShardRun>& shards) {
   out["scenes"] = in_scene_order(shards, "scenes", "label");
   out["builds"] = in_scene_order(shards, "builds", "scene");
   out["results"] = in_scene_order(shards, "results", "scene");
+  fill_frame_summary(out);  // over every shard's animated scenes, as one run sums them
   out["interrupted"] = false;
   out["complete"] = true;
   return out;
