@@ -60,6 +60,8 @@ class Runner {
                                      json& base);
   void run_config(const Target& target, const SceneSpec& scene, const AccelSpec& spec,
                   std::vector<RaySet>& sets);
+  void run_sets(const Accelerator& accel, const Target& target, const std::string& where,
+                const AccelSpec& spec, std::vector<RaySet>& sets, const json& base);
   void run_ray_set(const Accelerator& accel, const Target& target, const std::string& what,
                    const AccelSpec& spec, RaySet& set, const json& base);
   void time_closest(const Accelerator& accel, const std::string& name, RaySet& set,
@@ -216,24 +218,23 @@ void Runner::run_animated_scene(const SceneSpec& scene) {
   }
 }
 
-/// One frame of one configuration x strategy: the update (timed alone, once: a frame's update changes the
-/// structure, so it is not repeated), its build entry, then every ray set verified and timed as for a
-/// static scene. The rows carry frame, strategy, update_seconds and the SAH cost against a rebuild's.
+/// One frame of one configuration x strategy: the update (timed alone: FrameUpdater::repeat_update does it
+/// again build_repetitions times, the update itself the warm-up), its build entry, then every ray set
+/// verified and timed as for a static scene. The rows carry frame, strategy, update_seconds and the SAH cost
+/// against a rebuild's.
 void Runner::run_frame(FrameCase& c, const Target& target, const SceneSpec& scene, uint64_t frame,
                        std::vector<RaySet>& sets, std::map<std::string, double>& rebuild_cost) {
   const FrameUpdate u = c.updater->update(target.scene);
+  const Timing t =
+      timer_.time_build("update/" + scene.label + "/frame" + std::to_string(frame) + "/" + c.spec.label,
+                        double(target.triangles), [&] { return c.updater->repeat_update(); });
   const Accelerator& accel = c.updater->accelerator();
-  Timing t;
-  t.median = t.min = t.max = t.mean = u.seconds;
-  t.repetitions = 1;
-  t.iterations = 1;
-  t.samples = {u.seconds};
   const std::string base_label = c.spec.label.substr(0, c.spec.label.rfind(':'));
   if (u.rebuilt && !rebuild_cost.count(base_label)) rebuild_cost[base_label] = u.sah_cost;
   const json frame_fields = {{"frame", frame},
                              {"frames", scene.frames},
                              {"strategy", c.strategy},
-                             {"update_seconds", u.seconds},
+                             {"update_seconds", t.median},
                              {"rebuilt", u.rebuilt},
                              {"update_sah_cost", u.sah_cost > 0 ? json(u.sah_cost) : json()},
                              {"sah_ratio_to_rebuild",
@@ -247,17 +248,7 @@ void Runner::run_frame(FrameCase& c, const Target& target, const SceneSpec& scen
   report_["builds"].push_back(entry);
   const std::string where = scene.label + " frame " + std::to_string(frame) + " / " + c.spec.label;
   progress_.step(where + ": updated");
-  if (suite_.build_only) {
-    json row = base;
-    row["query"] = "build";
-    row["verified"] = true;
-    report_["results"].push_back(row);
-    return;
-  }
-  for (RaySet& set : sets) {
-    if (stopping()) return;
-    run_ray_set(accel, target, where + " / " + set.spec->label, c.spec, set, base);
-  }
+  run_sets(accel, target, where, c.spec, sets, base);
 }
 
 /// Builds the configuration build_repetitions times (each build timed alone), records its build entry and
@@ -283,6 +274,13 @@ void Runner::run_config(const Target& target, const SceneSpec& scene, const Acce
   json base;
   const std::unique_ptr<Accelerator> accel = build(target, scene.label, spec, base);
   progress_.step(scene.label + " " + spec.label + ": built");
+  run_sets(*accel, target, scene.label + " / " + spec.label, spec, sets, base);
+}
+
+/// A built (or updated) configuration's rows: one "build" row in a build-only suite, otherwise every ray
+/// set verified and timed (`where` names the case in progress lines).
+void Runner::run_sets(const Accelerator& accel, const Target& target, const std::string& where,
+                      const AccelSpec& spec, std::vector<RaySet>& sets, const json& base) {
   if (suite_.build_only) {
     json row = base;
     row["query"] = "build";
@@ -292,7 +290,7 @@ void Runner::run_config(const Target& target, const SceneSpec& scene, const Acce
   }
   for (RaySet& set : sets) {
     if (stopping()) return;
-    run_ray_set(*accel, target, scene.label + " / " + spec.label + " / " + set.spec->label, spec, set, base);
+    run_ray_set(accel, target, where + " / " + set.spec->label, spec, set, base);
   }
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 
 #include "accel/core/registry.h"
-#include "accel/reference/embree_scene.h"
 
 namespace ab {
 
@@ -102,6 +101,14 @@ void SceneAccelerator::aggregate_stats() {
   stats_.build_seconds = seconds;
 }
 
+void embree_scene_inputs(const Scene& scene, std::vector<std::shared_ptr<const Mesh>>& meshes,
+                         std::vector<EmbreeInstanceInput>& instances) {
+  meshes.clear();
+  instances.clear();
+  for (const SceneMesh& m : scene.meshes) meshes.push_back(m.mesh);
+  for (const SceneInstance& si : scene.instances) instances.push_back({si.mesh, si.transform.to_world});
+}
+
 std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene> scene,
                                                     const std::string& name, const Params& params,
                                                     const std::string& top, const std::string& bottom) {
@@ -109,9 +116,8 @@ std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene>
   const std::string b = bottom.empty() ? name : bottom;
   if (t == kEmbreeName && b == kEmbreeName) {
     std::vector<std::shared_ptr<const Mesh>> meshes;
-    for (const SceneMesh& m : scene->meshes) meshes.push_back(m.mesh);
     std::vector<EmbreeInstanceInput> instances;
-    for (const SceneInstance& si : scene->instances) instances.push_back({si.mesh, si.transform.to_world});
+    embree_scene_inputs(*scene, meshes, instances);
     Params p = params;
     return make_embree_scene(std::move(meshes), std::move(instances), p);
   }

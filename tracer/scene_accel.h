@@ -9,6 +9,7 @@
 #include "accel/core/accelerator.h"
 #include "accel/core/instances.h"
 #include "accel/core/params.h"
+#include "accel/reference/embree_scene.h"
 #include "tracer/scene.h"
 
 namespace ab {
@@ -80,6 +81,11 @@ class SceneAccelerator final : public Accelerator {
 /// The parameters of one level: plain keys and keys with `prefix.` (prefix removed); keys of the
 /// other level are dropped.
 Params level_params(const Params& params, const std::string& prefix, const std::string& other);
+
+/// What Embree's own instancing is given of a scene (embree_scene.h): its meshes at the scene's time, and
+/// each instance's mesh and object-to-world matrix in document order.
+void embree_scene_inputs(const Scene& scene, std::vector<std::shared_ptr<const Mesh>>& meshes,
+                         std::vector<EmbreeInstanceInput>& instances);
 
 /// Creates (not builds) the accelerator for a scene: Embree's own two-level instancing when both
 /// levels are `embree`, a SceneAccelerator otherwise. Empty top/bottom fall back to `name`.

@@ -57,8 +57,11 @@ bool FrameUpdater::supports(const std::string& name, const Params& params, Updat
   } catch (const std::exception&) {
     return false;  // not a structure of scenes (the rebuild strategy reports the error)
   }
+  // Embree's own instancing follows frames by rebuilding or by its refit (it reports no SAH cost to adapt
+  // by).
+  if (dynamic_cast<EmbreeSceneFrames*>(accel.get())) return strategy == UpdateStrategy::kRefit;
   auto* two_level = dynamic_cast<SceneAccelerator*>(accel.get());
-  if (!two_level) return false;  // Embree's own instancing: rebuilt every frame only
+  if (!two_level) return false;
   if (strategy == UpdateStrategy::kTopLevel) return true;
   accel->build();
   auto moved = std::make_shared<Scene>(*scene);
@@ -68,16 +71,35 @@ bool FrameUpdater::supports(const std::string& name, const Params& params, Updat
 }
 
 FrameUpdate FrameUpdater::update(std::shared_ptr<const Scene> frame) {
-  if (!accel_ || strategy_ == UpdateStrategy::kRebuild) return rebuild(std::move(frame));
-  if (strategy_ == UpdateStrategy::kTopLevel) return refit(std::move(frame), true);
-  if (strategy_ == UpdateStrategy::kAdaptive && rebuilt_cost_ > 0.0 &&
-      last_cost_ > threshold_ * rebuilt_cost_)
-    return rebuild(std::move(frame));
-  return refit(std::move(frame), false);
+  previous_ = std::move(current_);
+  current_ = frame;
+  last_top_only_ = strategy_ == UpdateStrategy::kTopLevel;
+  last_rebuilt_ = !accel_ || strategy_ == UpdateStrategy::kRebuild ||
+                  (strategy_ == UpdateStrategy::kAdaptive && rebuilt_cost_ > 0.0 &&
+                   last_cost_ > threshold_ * rebuilt_cost_);
+  return last_rebuilt_ ? rebuild(std::move(frame)) : refit(std::move(frame), last_top_only_);
+}
+
+double FrameUpdater::repeat_update() {
+  if (!accel_) throw InputError(name_ + ": no update to repeat");
+  const double rebuilt_cost = rebuilt_cost_, last_cost = last_cost_;
+  const int rebuilds = rebuilds_;
+  double seconds = 0.0;
+  if (last_rebuilt_) {
+    seconds = rebuild(current_).seconds;
+  } else {
+    refit(previous_, last_top_only_);  // back to where the update started (refits depend on positions only)
+    seconds = refit(current_, last_top_only_).seconds;
+  }
+  rebuilt_cost_ = rebuilt_cost, last_cost_ = last_cost, rebuilds_ = rebuilds;
+  return seconds;
 }
 
 FrameUpdate FrameUpdater::rebuild(std::shared_ptr<const Scene> frame) {
   accel_ = make_scene_accelerator(std::move(frame), name_, params_);
+  if (auto* embree = dynamic_cast<EmbreeSceneFrames*>(accel_.get());
+      embree && strategy_ == UpdateStrategy::kRefit)
+    embree->build_for_refit();
   accel_->build();
   FrameUpdate out{accel_->stats().build_seconds, update_sah_cost(*accel_), true};
   rebuilt_cost_ = last_cost_ = out.sah_cost;
@@ -87,10 +109,19 @@ FrameUpdate FrameUpdater::rebuild(std::shared_ptr<const Scene> frame) {
 
 FrameUpdate FrameUpdater::refit(std::shared_ptr<const Scene> frame, bool top_only) {
   auto* two_level = dynamic_cast<SceneAccelerator*>(accel_.get());
+  auto* embree = dynamic_cast<EmbreeSceneFrames*>(accel_.get());
   using L = SceneAccelerator::LevelUpdate;
   const L level = top_only ? L::kRebuild : L::kRefit;
-  if (!two_level || !two_level->update(std::move(frame), level, level))
-    throw InputError(name_ + ": cannot follow the frame by " + strategy_name(strategy_));
+  bool done = false;
+  if (two_level) {
+    done = two_level->update(std::move(frame), level, level);
+  } else if (embree && !top_only) {
+    std::vector<std::shared_ptr<const Mesh>> meshes;
+    std::vector<EmbreeInstanceInput> instances;
+    embree_scene_inputs(*frame, meshes, instances);
+    done = embree->refit_frame(meshes, instances);
+  }
+  if (!done) throw InputError(name_ + ": cannot follow the frame by " + strategy_name(strategy_));
   FrameUpdate out{accel_->stats().build_seconds, update_sah_cost(*accel_), false};
   last_cost_ = out.sah_cost;
   return out;

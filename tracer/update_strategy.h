@@ -54,12 +54,18 @@ class FrameUpdater {
   FrameUpdater(std::string name, Params params, UpdateStrategy strategy, double threshold = 1.5);
 
   /// True when structure `name` can follow `strategy`: rebuild always; refit and adaptive when both of
-  /// its levels refit (probed on a one-triangle scene); top-level for the project's two-level structures.
+  /// its levels refit (probed on a one-triangle scene); top-level for the project's two-level structures;
+  /// Embree's own instancing refits (EmbreeSceneFrames) but has no SAH cost for adaptive.
   static bool supports(const std::string& name, const Params& params, UpdateStrategy strategy);
 
   /// Brings the structure to `frame` (scene_at of the same scene): the first call builds, later calls
   /// update by the strategy. Throws InputError when the frame does not match the first one's meshes.
   FrameUpdate update(std::shared_ptr<const Scene> frame);
+  /// Does the last update again, to time it with repetitions as builds are (the update alone): a rebuild
+  /// builds the frame again; a refit first goes back to the previous frame's positions (untimed), then
+  /// refits to the frame again, the same work on the same structure. The strategy's state (costs, rebuild
+  /// count) and the resulting structure are as after the update itself. Returns the seconds of the update.
+  double repeat_update();
   /// The current structure (after the first update).
   const Accelerator& accelerator() const { return *accel_; }
   /// Frames rebuilt from scratch so far (the first included).
@@ -77,6 +83,9 @@ class FrameUpdater {
   double rebuilt_cost_ = 0.0;  ///< cost right after the last rebuild
   double last_cost_ = 0.0;     ///< cost after the last update
   int rebuilds_ = 0;
+  std::shared_ptr<const Scene> current_, previous_;  ///< the frame of the last update, and the one before
+  bool last_rebuilt_ = false;                        ///< the last update built from scratch
+  bool last_top_only_ = false;                       ///< the last refit kept the bottom levels
 };
 
 }  // namespace ab

@@ -1,7 +1,6 @@
 #include "accel/reference/embree.h"
 
 #include <algorithm>
-#include <cstring>
 
 #include "accel/core/registry.h"
 
@@ -41,12 +40,7 @@ void EmbreeMesh::commit_frame(std::shared_ptr<const TrianglePrims> prims, RTCBui
     geometry_quality_ = quality;
     return;
   }
-  RTCGeometry geom = rtcGetGeometry(scene_, 0);
-  auto* vertices = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
-  std::memcpy(vertices, mesh.vertices.data(), sizeof(float) * 3 * mesh.vertices.size());
-  rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
-  rtcCommitGeometry(geom);
-  rtcCommitScene(scene_);
+  update_mesh_vertices(scene_, mesh);
   check_embree_error("dynamic commit");
 }
 

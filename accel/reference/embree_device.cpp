@@ -91,4 +91,15 @@ RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFl
   return scene;
 }
 
+void update_mesh_vertices(RTCScene scene, const Mesh& mesh) {
+  if (mesh.size() > 0) {
+    RTCGeometry geom = rtcGetGeometry(scene, 0);
+    auto* vertices = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    std::memcpy(vertices, mesh.vertices.data(), sizeof(float) * 3 * mesh.vertices.size());
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+  }
+  rtcCommitScene(scene);
+}
+
 }  // namespace ab

@@ -42,6 +42,10 @@ RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFl
 RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags,
                            RTCBuildQuality geometry_quality);
 
+/// Moves geometry 0 of a scene made by commit_mesh_scene to `mesh`'s vertex positions (the same vertex count)
+/// in place, and commits the geometry and the scene again: a refit when the geometry's quality is
+/// RTC_BUILD_QUALITY_REFIT, a rebuild of the scene's quality otherwise. Nothing happens for an empty mesh.
+void update_mesh_vertices(RTCScene scene, const Mesh& mesh);
 /// Throws InputError naming `what` when the device has recorded an error (and clears it).
 void check_embree_error(const char* what);
 

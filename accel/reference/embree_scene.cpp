@@ -1,5 +1,6 @@
 #include "accel/reference/embree_scene.h"
 
+#include <chrono>
 #include <glm/gtc/type_ptr.hpp>
 #include <string>
 
@@ -12,7 +13,7 @@ namespace {
 
 /// Embree over a scene with its own instances. Every Embree scene of it is robust (RTC_SCENE_FLAG_ROBUST:
 /// no culling shortcuts, as befits the reference of `verify --scene`).
-class EmbreeScene final : public Accelerator {
+class EmbreeScene final : public Accelerator, public EmbreeSceneFrames {
  public:
   EmbreeScene(std::vector<std::shared_ptr<const Mesh>> meshes, std::vector<EmbreeInstanceInput> instances,
               const EmbreeConfig& config)
@@ -46,6 +47,10 @@ class EmbreeScene final : public Accelerator {
   void intersect_one(const Ray& ray, Hit& best, uint32_t, RayCounters*) const override;
   bool occluded_one(const Ray& ray, RayCounters*) const override;
 
+  void build_for_refit() override { for_refit_ = true; }
+  bool refit_frame(const std::vector<std::shared_ptr<const Mesh>>& meshes,
+                   const std::vector<EmbreeInstanceInput>& instances) override;
+
  protected:
   void do_build() override;
   void gather_stats(BuildStats& stats) const override;
@@ -53,6 +58,12 @@ class EmbreeScene final : public Accelerator {
  private:
   void commit_top();
   void release();
+  /// The scene flags of every level: robust, and dynamic when built for refitting.
+  RTCSceneFlags flags() const {
+    return for_refit_ ? RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC) : RTC_SCENE_FLAG_ROBUST;
+  }
+  /// The build quality of every scene: low when built for refitting (see EmbreeSceneFrames).
+  RTCBuildQuality scene_quality() const { return for_refit_ ? RTC_BUILD_QUALITY_LOW : config_.quality; }
 
   std::vector<std::shared_ptr<const Mesh>> meshes_;
   std::vector<EmbreeInstanceInput> instances_;
@@ -60,13 +71,15 @@ class EmbreeScene final : public Accelerator {
   AABB bounds_;
   std::vector<RTCScene> bottoms_;
   RTCScene top_ = nullptr;
+  bool for_refit_ = false;
 };
 
 void EmbreeScene::do_build() {
   release();
   const int64_t bytes_before = embree_bytes_in_use();
+  const RTCBuildQuality geometry_quality = for_refit_ ? RTC_BUILD_QUALITY_REFIT : config_.quality;
   for (const auto& m : meshes_)
-    bottoms_.push_back(commit_mesh_scene(*m, config_.quality, RTC_SCENE_FLAG_ROBUST));
+    bottoms_.push_back(commit_mesh_scene(*m, scene_quality(), flags(), geometry_quality));
   commit_top();
   const int64_t grown = embree_bytes_in_use() - bytes_before;
   stats_.bytes = grown > 0 ? static_cast<uint64_t>(grown) : 0;
@@ -76,8 +89,8 @@ void EmbreeScene::do_build() {
 void EmbreeScene::commit_top() {
   RTCDevice device = embree_device();
   top_ = rtcNewScene(device);
-  rtcSetSceneFlags(top_, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(top_, config_.quality);
+  rtcSetSceneFlags(top_, flags());
+  rtcSetSceneBuildQuality(top_, scene_quality());
   for (size_t i = 0; i < instances_.size(); ++i) {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(g, bottoms_[instances_[i].mesh]);
@@ -89,6 +102,39 @@ void EmbreeScene::commit_top() {
   }
   rtcCommitScene(top_);
   check_embree_error("scene build");
+}
+
+bool EmbreeScene::refit_frame(const std::vector<std::shared_ptr<const Mesh>>& meshes,
+                              const std::vector<EmbreeInstanceInput>& instances) {
+  if (!for_refit_ || !top_ || meshes.size() != meshes_.size() || instances.size() != instances_.size())
+    return false;
+  for (size_t m = 0; m < meshes.size(); ++m)
+    if (meshes[m]->vertices.size() != meshes_[m]->vertices.size() || meshes[m]->size() != meshes_[m]->size())
+      return false;
+  for (size_t i = 0; i < instances.size(); ++i)
+    if (instances[i].mesh != instances_[i].mesh) return false;
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    if (meshes[m] != meshes_[m]) update_mesh_vertices(bottoms_[m], *meshes[m]);
+    meshes_[m] = meshes[m];
+  }
+  instances_ = instances;
+  bounds_ = AABB{};
+  for (size_t i = 0; i < instances_.size(); ++i) {
+    RTCGeometry g = rtcGetGeometry(top_, static_cast<unsigned>(i));
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, glm::value_ptr(instances_[i].to_world));
+    rtcCommitGeometry(g);
+    bounds_.extend(transform_bounds(meshes_[instances_[i].mesh]->bounds(), instances_[i].to_world));
+  }
+  rtcCommitScene(top_);
+  check_embree_error("scene refit");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const uint64_t bytes = stats_.bytes;
+  stats_ = BuildStats{};
+  stats_.build_seconds = seconds;
+  stats_.bytes = bytes;
+  gather_stats(stats_);
+  return true;
 }
 
 void EmbreeScene::gather_stats(BuildStats& stats) const {

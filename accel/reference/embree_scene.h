@@ -19,10 +19,27 @@ struct EmbreeInstanceInput {
   glm::mat4 to_world{1.0f};  ///< object-to-world matrix
 };
 
+/// What the `refit` strategy (tracer/update_strategy.h) asks of an Embree scene: built for refitting, as
+/// EmbreeMesh::commit_frame does for a mesh (every level a low-quality RTC_SCENE_FLAG_DYNAMIC scene, the mesh
+/// geometries at RTC_BUILD_QUALITY_REFIT: Embree honours a geometry's own quality only there), then moved to
+/// each frame in place: changed vertex buffers refitted, instance transforms set, the top level committed.
+class EmbreeSceneFrames {
+ public:
+  virtual ~EmbreeSceneFrames() = default;
+  /// Makes the following build() commit every level for refitting.
+  virtual void build_for_refit() = 0;
+  /// Moves the built scene to a frame with the same meshes (vertex counts) and instances; a mesh given by
+  /// the same pointer as before is kept. The wall time of the whole update is stats().build_seconds. False,
+  /// with nothing changed, when the frame does not match or the scene was not built for refitting.
+  virtual bool refit_frame(const std::vector<std::shared_ptr<const Mesh>>& meshes,
+                           const std::vector<EmbreeInstanceInput>& instances) = 0;
+};
+
 /// Creates (does not build) an Embree scene: one Embree scene per base mesh, each committed once, and
 /// a top scene with one instance geometry per instance (geometry id = instance index, so Embree's
 /// instID is the contract's `inst`). Parameters: EmbreeConfig (quality=low|medium|high, default medium),
-/// checked and recorded as the registry does for every structure (name `embree`, effective config).
+/// checked and recorded as the registry does for every structure (name `embree`, effective config). The
+/// result is also an EmbreeSceneFrames.
 std::unique_ptr<Accelerator> make_embree_scene(std::vector<std::shared_ptr<const Mesh>> meshes,
                                                std::vector<EmbreeInstanceInput> instances, Params& params);
 
