@@ -80,7 +80,7 @@ struct Camera {
     const float sx = (static_cast<float>(pixel % width) + rng.uniform()) / static_cast<float>(width);
     const float sy = (static_cast<float>(pixel / width) + rng.uniform()) / static_cast<float>(height);
     const vec3 d = forward + tan_half * ((2.0f * sx - 1.0f) * right + (1.0f - 2.0f * sy) * up);
-    return Ray{eye, glm::normalize(d), 0.0f, kInf};
+    return Ray{eye, glm::normalize(d), 0.0f, kInf, 0.0f};
   }
 };
 
@@ -207,7 +207,7 @@ std::vector<Ray> incoherent_rays(const Frame& f, uint64_t count, uint64_t seed) 
   for (uint64_t i = 0; i < count; ++i) {
     Rng rng = ray_rng(seed, 2, i);
     const vec3 org = f.box.lo + extent * rng.unit_cube();
-    rays[i] = Ray{org, rng.unit_sphere(), 0.0f, kInf};
+    rays[i] = Ray{org, rng.unit_sphere(), 0.0f, kInf, 0.0f};
   }
   return rays;
 }

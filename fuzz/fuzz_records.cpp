@@ -12,11 +12,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = fuzz::write_input(data, size, "rays");
   try {
     const auto rays = ab::read_rays(path);
-    FUZZ_CHECK(size == 16 + 32 * rays.size());
+    FUZZ_CHECK(size == 16 + ab::ray_record_bytes(path) * rays.size());  // ABRAYS01: 32, ABRAYS02: 36
     for (const auto& r : rays) {
       for (float f : {r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, r.tmin})
         FUZZ_CHECK(std::isfinite(f));
       FUZZ_CHECK(!std::isnan(r.tmax));
+      FUZZ_CHECK(r.time >= 0.0f && r.time <= 1.0f);
     }
   } catch (const ab::InputError&) {
   }

@@ -36,7 +36,7 @@ const CommandRegistrar kRays{
              load_target(a->target.mesh, a->target.scene, a->target.frame.normalized_time());
          // Scenes: the tracer's own kinds (camera and lights of the scene).
          const std::vector<Ray> rays = make_target_rays(target, a->kind, a->count, a->seed, a->views);
-         write_rays(a->output, rays);
+         write_rays(a->output, rays, a->kind == "motion" ? RayFileVersion::kV2 : RayFileVersion::kV1);
          return 0;
        };
      }}};

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "accel/core/error.h"
+#include "harness/hitfile.h"
 
 namespace ab {
 
@@ -37,7 +38,7 @@ double scene_triangles(const SceneSpec& scene) {
 
 double ray_count(const RaySpec& rays) {
   if (rays.path.empty()) return double(rays.count);
-  return std::max(1.0, (file_bytes(rays.path) - 16.0) / 32.0);  // ABRAYS01: 32 bytes a ray
+  return std::max(1.0, (file_bytes(rays.path) - 16.0) / double(ray_record_bytes(rays.path)));
 }
 
 }  // namespace

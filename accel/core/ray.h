@@ -15,14 +15,17 @@ inline constexpr float kInf = std::numeric_limits<float>::infinity();
 inline constexpr uint32_t kInvalidId = 0xFFFFFFFFu;
 
 /// A ray: origin, direction (not necessarily normalized, may have zero components), and the
-/// parametric interval [tmin, tmax] in units of that direction. Layout matches the .rays record.
+/// parametric interval [tmin, tmax] in units of that direction, and a time in [0, 1] within the camera's
+/// shutter (motion blur; 0 for rays of a static scene). Layout matches the ABRAYS02 record (ABRAYS01
+/// records are its first 32 bytes).
 struct Ray {
   vec3 org{0.0f};
   vec3 dir{0.0f, 0.0f, 1.0f};
   float tmin = 0.0f;
   float tmax = kInf;
+  float time = 0.0f;
 };
-static_assert(sizeof(Ray) == 32);
+static_assert(sizeof(Ray) == 36);
 
 /// The closest hit of a ray. Layout matches the .hits record. A miss has t = +inf and invalid ids.
 struct Hit {
