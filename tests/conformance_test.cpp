@@ -246,7 +246,7 @@ TEST_P(Conformance, BothLevelsOfInstancing) {
       m = glm::rotate(m, 0.3f * float(i), glm::normalize(vec3(1, 2, 3)));
       m = glm::scale(m, vec3(1.0f + 0.1f * float(i), 0.5f + 0.05f * float(i), 1.0f));
       if (i == 5) m = glm::translate(glm::mat4(1.0f), vec3(2.5f, 3.0f, 2.0f));  // exact overlap with another
-      list.push_back({base, m, glm::inverse(m), 0});
+      list.push_back({base, m, glm::inverse(m), 0, {}});
     }
     return std::make_shared<const InstancePrims>(std::move(list));
   };

@@ -2,6 +2,7 @@
 // distributing rays over the lens). With aperture 0 it is a pinhole camera.
 #pragma once
 
+#include <cstdint>
 #include <glm/glm.hpp>
 
 #include "accel/core/aabb.h"
@@ -16,6 +17,12 @@ struct Camera {
   float fov_degrees = 45.0f;    ///< vertical field of view
   float aperture = 0.0f;        ///< lens radius in world units (0: pinhole)
   float focal_distance = 0.0f;  ///< distance to the plane in focus (0: distance from eye to look_at)
+  float shutter_open = 0.0f;    ///< scene time (keys' units) the shutter opens, relative to the frame's time
+  float shutter_close = 0.0f;   ///< ... and closes (== shutter_open: closed, no motion blur)
+  uint32_t motion_steps = 3;    ///< time steps the motion is sampled at over the shutter (>= 2)
+
+  /// True when the shutter spans an interval (motion blur).
+  bool has_shutter() const { return shutter_close > shutter_open; }
 };
 
 /// The camera prepared for an image of a given aspect: generates primary rays.

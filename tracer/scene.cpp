@@ -187,8 +187,9 @@ class SceneParser {
   void camera(const pugi::xml_node& n) {
     check_attributes(n, {});
     Camera& cam = scene_.camera;
-    children(n, {"eye", "lookat", "up", "fov", "aperture", "focus"},
+    children(n, {"eye", "lookat", "up", "fov", "aperture", "focus", "shutter"},
              [&](const pugi::xml_node& c, const std::string& k) {
+               if (k == "shutter") shutter(c, cam);
                if (k == "eye") cam.eye = vector3(c);
                if (k == "lookat") cam.look_at = vector3(c);
                if (k == "up") cam.up = vector3(c);
@@ -200,6 +201,15 @@ class SceneParser {
     if (glm::length(f) == 0.0f) fail(n, "camera eye and lookat coincide");
     if (glm::length(glm::cross(f, cam.up)) <= 1e-6f * glm::length(f) * glm::length(cam.up))
       fail(n, "camera up is zero or parallel to the view direction");
+  }
+
+  /// <shutter open="O" close="C" steps="T"/>: the scene-time interval around the frame (motion blur).
+  void shutter(const pugi::xml_node& n, Camera& cam) {
+    check_attributes(n, {"open", "close", "steps"});
+    cam.shutter_open = attribute_number(n, "open", 0.0f);
+    cam.shutter_close = attribute_number(n, "close", 0.0f);
+    cam.motion_steps = static_cast<uint32_t>(attribute_integer(n, "steps", cam.motion_steps, 2, 64));
+    if (cam.shutter_close < cam.shutter_open) fail(n, "the shutter closes before it opens");
   }
 
   void render(const pugi::xml_node& n) {

@@ -11,12 +11,16 @@
 #include "accel/core/params.h"
 #include "accel/reference/embree_scene.h"
 #include "tracer/scene.h"
+#include "tracer/scene_motion.h"
 
 namespace ab {
 
 /// Two levels of registered structures. Hits: inst = instance index (document order), prim =
-/// triangle id in that instance's base mesh. Parameters: `top.k=v` goes to the top level only,
-/// `bottom.k=v` to the bottom level only, plain `k=v` to both.
+/// triangle id in that instance's base mesh. With the camera's shutter open, a base mesh that deforms
+/// during it has a bottom over its time steps (MotionTrianglePrims) and an instance that moves carries its
+/// matrices at the time steps (motion blur: tracer/scene_motion.h); update() then declines (rebuild).
+/// Parameters: `top.k=v` goes to the top level only, `bottom.k=v` to the bottom level only, plain `k=v` to
+/// both.
 class SceneAccelerator final : public Accelerator {
  public:
   /// Creates (does not build) the structures; throws UnknownAccelerator or ParamError.
@@ -70,6 +74,7 @@ class SceneAccelerator final : public Accelerator {
   std::vector<Instance> make_instances() const;
 
   std::shared_ptr<const Scene> scene_;
+  SceneMotion motion_;  ///< what moves during the shutter (nothing when it is closed)
   std::string top_name_, bottom_name_;
   Params top_params_, bottom_params_;
   std::vector<std::shared_ptr<Accelerator>> bottoms_;

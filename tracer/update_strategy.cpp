@@ -129,7 +129,7 @@ FrameUpdate FrameUpdater::refit(std::shared_ptr<const Scene> frame, bool top_onl
 
 // SceneAccelerator::update lives here with the strategies that call it (scene_accel.cpp builds).
 bool SceneAccelerator::update(std::shared_ptr<const Scene> frame, LevelUpdate bottom, LevelUpdate top) {
-  if (!top_ || frame->meshes.size() != scene_->meshes.size() ||
+  if (!top_ || motion_.any() || frame->meshes.size() != scene_->meshes.size() ||
       frame->instances.size() != scene_->instances.size())
     return false;
   const auto start = std::chrono::steady_clock::now();

@@ -16,7 +16,8 @@ const std::vector<RayKindInfo>& scene_ray_kinds() {
       {"glossy",
        "scene: glossy reflection (Phong lobe of the material's roughness, 0.1 if not glossy) at primary "
        "hits"},
-      {"diffuse", "scene: cosine-weighted bounce at primary hits"}};
+      {"diffuse", "scene: cosine-weighted bounce at primary hits"},
+      {"motion", "scene: the primary rays with a time each, uniform over the camera's shutter (ABRAYS02)"}};
   return kinds;
 }
 
@@ -51,13 +52,16 @@ class CameraSweep {
     h_ = std::max<uint64_t>(1, uint64_t(std::ceil(n / double(w_))));
   }
   /// Ray j.
-  Ray ray(uint64_t j, uint64_t seed) const {
+  /// Ray j; with `timed`, its time is the generator's next number (the pixel and lens ones unchanged).
+  Ray ray(uint64_t j, uint64_t seed, bool timed = false) const {
     const CameraRays rays(camera_, int(w_), int(h_));
     Rng rng(seed, j);
     const uint64_t pixel = j % (w_ * h_);
     const float px = float(pixel % w_) + rng.uniform(), py = float(pixel / w_) + rng.uniform();
     const float lu = rng.uniform(), lv = rng.uniform();
-    return rays.generate(px, py, lu, lv);
+    Ray r = rays.generate(px, py, lu, lv);
+    if (timed) r.time = rng.uniform();
+    return r;
   }
 
  private:
@@ -111,8 +115,8 @@ std::vector<Ray> make_scene_rays(const Scene& scene, const TraceFn& trace, const
   const CameraSweep sweep(scene, count, kind == "dof");
   std::vector<Ray> out;
   out.reserve(count);
-  if (kind == "primary" || kind == "dof") {
-    for (uint64_t j = 0; j < count; ++j) out.push_back(sweep.ray(j, seed));
+  if (kind == "primary" || kind == "dof" || kind == "motion") {
+    for (uint64_t j = 0; j < count; ++j) out.push_back(sweep.ray(j, seed, kind == "motion"));
     return out;
   }
   if (kind == "shadow" && scene.area_lights.empty() && scene.point_lights.empty())

@@ -8,10 +8,12 @@
 
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <vector>
 
 #include "accel/core/aabb.h"
 #include "accel/core/instances.h"
+#include "accel/core/motion_prims.h"
 #include "accel/core/primitives.h"
 
 namespace ab {
@@ -63,8 +65,11 @@ inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec
   for (int k = 0; k < poly.n; ++k) out[k] = poly.v[k];
   return poly.n;
 }
-/// An instance's support points in box: the corners of its world box clipped to box.
-inline int support_points(const InstancePrims& p, size_t i, const AABB& box, vec3* out) {
+/// The support points in box of a primitive known by its box only (an instance's world box, a moving
+/// triangle's swept box): the corners of that box clipped to box.
+template <class P>
+requires std::same_as<P, InstancePrims> || std::same_as<P, MotionTrianglePrims>
+inline int support_points(const P& p, size_t i, const AABB& box, vec3* out) {
   const AABB b = AABB::intersection(p.bounds(i), box);
   if (b.empty()) return 0;
   for (int c = 0; c < 8; ++c)
@@ -82,8 +87,10 @@ inline bool supporting_plane(const TrianglePrims& p, size_t i, BspPlane& plane) 
   plane.d = glm::dot(plane.n, t.v0);
   return std::isfinite(plane.d);
 }
-/// Instances offer no supporting plane (their boxes are classified by corners only).
-inline bool supporting_plane(const InstancePrims&, size_t, BspPlane&) {
+/// Instances and moving triangles offer no supporting plane (their boxes are classified by corners only).
+template <class P>
+requires std::same_as<P, InstancePrims> || std::same_as<P, MotionTrianglePrims>
+inline bool supporting_plane(const P&, size_t, BspPlane&) {
   return false;
 }
 

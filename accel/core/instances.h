@@ -8,17 +8,34 @@
 #include "accel/core/aabb.h"
 #include "accel/core/accelerator.h"
 #include "accel/core/clip.h"
+#include "accel/core/motion.h"
 
 namespace ab {
 
 /// One placement of a base mesh: its structure (shared by every instance of that mesh), the
-/// object-to-world transform and its inverse.
+/// object-to-world transform and its inverse; a moving instance (motion blur) also has its object-to-world
+/// transform at the shutter's time steps.
 struct Instance {
   std::shared_ptr<const Accelerator> base;
   glm::mat4 to_world{1.0f};
   glm::mat4 to_object{1.0f};
-  uint32_t mesh_index = 0;  ///< which base mesh (for reports and flattening)
+  uint32_t mesh_index = 0;                ///< which base mesh (for reports and flattening)
+  std::vector<glm::mat4> to_world_steps;  ///< at the shutter's time steps (empty: does not move)
+
+  /// True when the instance moves during the shutter.
+  bool moves() const { return !to_world_steps.empty(); }
 };
+
+/// The object-to-world transform of a moving instance at ray time `time`: its time steps interpolated
+/// entry by entry (motion.h, as Embree interpolates matrix time steps).
+inline glm::mat4 instance_to_world_at(const Instance& inst, float time) {
+  return matrix_at(inst.to_world_steps, time);
+}
+/// The world-to-object transform of a moving instance at ray time `time`: the inverse of
+/// instance_to_world_at, the one function that moves a ray into a moving instance.
+inline glm::mat4 instance_to_object_at(const Instance& inst, float time) {
+  return glm::inverse(instance_to_world_at(inst, time));
+}
 
 /// Moves a ray into an instance's object space by the inverse transform, without renormalizing the
 /// direction, so that t means the same distance along the ray in both spaces.
@@ -40,6 +57,35 @@ inline AABB transform_bounds(const AABB& b, const glm::mat4& m) {
   return out;
 }
 
+/// The growth of a moving instance's boxes over the shutter (`swept`, their union): 2^-12 of its size and
+/// magnitude, for the rounding of the interpolated matrix and its inverse.
+inline vec3 instance_motion_margin(const AABB& swept) {
+  return (swept.extent() + glm::max(glm::abs(swept.lo), glm::abs(swept.hi))) * 0x1p-12f;
+}
+
+/// World bounds of an instance over the shutter. A static instance: its base's box transformed. A moving
+/// one: the union of that box under every time step's matrix (a point moves along M(f) p = (1 - f) M_k p +
+/// f M_k+1 p within a segment, so this union is exact for the interpolation of matrix_at, rotations
+/// included), grown by instance_motion_margin.
+inline AABB instance_world_bounds(const Instance& inst) {
+  if (!inst.moves()) return transform_bounds(inst.base->bounds(), inst.to_world);
+  AABB out;
+  for (const glm::mat4& m : inst.to_world_steps) out.extend(transform_bounds(inst.base->bounds(), m));
+  if (out.empty()) return out;
+  const vec3 margin = instance_motion_margin(out);
+  return {out.lo - margin, out.hi + margin};
+}
+
+/// World bounds of a moving instance at its time step k, grown as instance_world_bounds grows (the motion
+/// BVH interpolates these boxes between the steps).
+inline AABB instance_step_bounds(const Instance& inst, size_t k) {
+  const AABB world = instance_world_bounds(inst);
+  const AABB b = transform_bounds(inst.base->bounds(), inst.to_world_steps[k]);
+  if (b.empty()) return b;
+  const vec3 margin = instance_motion_margin(world);
+  return {b.lo - margin, b.hi + margin};
+}
+
 /// The instances of a scene; primitive i is instance i (its index in document order).
 class InstancePrims {
  public:
@@ -47,7 +93,7 @@ class InstancePrims {
   explicit InstancePrims(std::vector<Instance> instances) : instances_(std::move(instances)) {
     world_.reserve(instances_.size());
     for (const Instance& inst : instances_) {
-      world_.push_back(transform_bounds(inst.base->bounds(), inst.to_world));
+      world_.push_back(instance_world_bounds(inst));
       bounds_.extend(world_.back());
     }
   }
@@ -72,19 +118,25 @@ class InstancePrims {
   bool intersect(size_t i, const Ray& ray, Hit& best, uint32_t /*inst*/, RayCounters& c) const {
     if constexpr (kCount) ++c.prims;
     const Hit before = best;
-    instances_[i].base->intersect_one(transform_ray(ray, instances_[i].to_object), best,
-                                      static_cast<uint32_t>(i), kCount ? &c : nullptr);
+    instances_[i].base->intersect_one(object_ray(i, ray), best, static_cast<uint32_t>(i),
+                                      kCount ? &c : nullptr);
     return best.t != before.t || best.prim != before.prim || best.inst != before.inst;
   }
   /// True when instance i blocks the ray within [tmin, tmax].
   template <bool kCount>
   bool occluded(size_t i, const Ray& ray, RayCounters& c) const {
     if constexpr (kCount) ++c.prims;
-    return instances_[i].base->occluded_one(transform_ray(ray, instances_[i].to_object),
-                                            kCount ? &c : nullptr);
+    return instances_[i].base->occluded_one(object_ray(i, ray), kCount ? &c : nullptr);
   }
 
  private:
+  /// The ray in instance i's object space (at the ray's time when the instance moves).
+  Ray object_ray(size_t i, const Ray& ray) const {
+    const Instance& inst = instances_[i];
+    if (!inst.moves()) return transform_ray(ray, inst.to_object);
+    return transform_ray(ray, instance_to_object_at(inst, ray.time));
+  }
+
   std::vector<Instance> instances_;
   std::vector<AABB> world_;
   AABB bounds_;

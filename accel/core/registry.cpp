@@ -64,3 +64,19 @@ std::unique_ptr<Accelerator> make_instance_accelerator(const std::string& name,
 }
 
 }  // namespace ab
+
+namespace ab {
+
+std::unique_ptr<Accelerator> make_motion_accelerator(const std::string& name,
+                                                     std::shared_ptr<const MotionTrianglePrims> prims,
+                                                     Params params) {
+  const AcceleratorInfo& info = find_accelerator(name);
+  if (!info.make_for_motion_mesh)
+    throw UnknownAccelerator("accelerator '" + name + "' cannot hold a moving mesh (motion blur)");
+  auto accel = info.make_for_motion_mesh(std::move(prims), params);
+  params.finish(name);
+  accel->identify(info.name, params.effective());
+  return accel;
+}
+
+}  // namespace ab

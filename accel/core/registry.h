@@ -11,6 +11,7 @@
 #include "accel/core/concepts.h"
 #include "accel/core/error.h"
 #include "accel/core/instances.h"
+#include "accel/core/motion_prims.h"
 #include "accel/core/params.h"
 #include "accel/core/primitives.h"
 
@@ -28,14 +29,19 @@ using MeshFactory =
 using InstanceFactory =
     std::function<std::unique_ptr<Accelerator>(std::shared_ptr<const InstancePrims>, Params&)>;
 
+/// Factory over a moving triangle set (motion blur: a deforming mesh's time steps).
+using MotionMeshFactory =
+    std::function<std::unique_ptr<Accelerator>(std::shared_ptr<const MotionTrianglePrims>, Params&)>;
+
 /// One registered accelerator.
 struct AcceleratorInfo {
   std::string name;
   std::string description;
   int order = 100;  ///< position in listings (smaller first)
   MeshFactory make_for_mesh;
-  InstanceFactory make_for_instances;  ///< empty when the structure cannot be a top level
-  bool is_reference = false;           ///< brute and embree: not a structure of the project's own
+  InstanceFactory make_for_instances;      ///< empty when the structure cannot be a top level
+  MotionMeshFactory make_for_motion_mesh;  ///< empty when the structure cannot hold a moving mesh
+  bool is_reference = false;               ///< brute and embree: not a structure of the project's own
 };
 
 /// Registers at static-initialization time: `static const Registrar reg{{"name", "...", 10, f, g}};`
@@ -62,6 +68,12 @@ std::unique_ptr<Accelerator> make_instance_accelerator(const std::string& name,
                                                        std::shared_ptr<const InstancePrims> prims,
                                                        Params params);
 
+/// Creates (does not build) an accelerator over a moving mesh; throws UnknownAccelerator (also when the
+/// structure cannot hold one) or ParamError.
+std::unique_ptr<Accelerator> make_motion_accelerator(const std::string& name,
+                                                     std::shared_ptr<const MotionTrianglePrims> prims,
+                                                     Params params);
+
 /// The factory of structure S over primitive set P: reads S's Config from the parameters once and passes
 /// it typed to the constructor (the shape of pbrt-v4's Create()).
 template <class S>
@@ -70,17 +82,19 @@ std::unique_ptr<Accelerator> create_structure(std::shared_ptr<const typename S::
   return std::make_unique<S>(std::move(prims), S::Config::read(params));
 }
 
-/// Describes structure template S for the registry, over both primitive sets; the concepts name what is
-/// missing when S<P> is not a Structure. The name given here is the only place it is written.
+/// Describes structure template S for the registry, over the three primitive sets (triangles, instances,
+/// moving triangles); the concepts name what is missing when S<P> is not a Structure. The name given here
+/// is the only place it is written.
 template <template <class> class S>
-requires Structure<S<TrianglePrims>> && Structure<S<InstancePrims>> AcceleratorInfo
-structure_info(std::string name, std::string description, int order) {
+requires Structure<S<TrianglePrims>> && Structure<S<InstancePrims>> && Structure<S<MotionTrianglePrims>>
+    AcceleratorInfo structure_info(std::string name, std::string description, int order) {
   AcceleratorInfo info;
   info.name = std::move(name);
   info.description = std::move(description);
   info.order = order;
   info.make_for_mesh = create_structure<S<TrianglePrims>>;
   info.make_for_instances = create_structure<S<InstancePrims>>;
+  info.make_for_motion_mesh = create_structure<S<MotionTrianglePrims>>;
   return info;
 }
 

@@ -1,0 +1,364 @@
+// Motion blur (issue 14): the ABRAYS02 ray file, the one triangle and transform interpolation, swept and
+// moving-instance bounds, and every registered structure byte-identical to brute on rays with times over
+// deforming meshes and moving instances (flattened and two-level scenes, 1 and 2 threads). New structures
+// are covered by registering.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "accel/core/error.h"
+#include "accel/core/motion_prims.h"
+#include "accel/core/registry.h"
+#include "accel/core/trace.h"
+#include "datasets/random.h"
+#include "harness/compare.h"
+#include "harness/hitfile.h"
+#include "tracer/integrator.h"
+#include "tracer/scene.h"
+#include "tracer/scene_accel.h"
+#include "tracer/scene_motion.h"
+#include "tracer/workload.h"
+
+namespace ab {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> structure_names() {
+  std::vector<std::string> names;
+  for (const auto& info : accelerators())
+    if (!info.is_reference && info.name.rfind("test-", 0) != 0) names.push_back(info.name);
+  return names;
+}
+
+fs::path temp_path(const std::string& name) {
+  return fs::temp_directory_path() / ("ab_motion_" + std::to_string(::getpid()) + "_" + name);
+}
+
+/// A soup of n small triangles in the unit cube (every third one static).
+Mesh soup(size_t n, uint64_t seed) {
+  Rng rng(seed);
+  Mesh m;
+  for (size_t i = 0; i < n; ++i) {
+    const vec3 c = rng.unit_cube();
+    for (int k = 0; k < 3; ++k) m.vertices.push_back(c + 0.08f * (rng.unit_cube() - vec3(0.5f)));
+    m.triangles.push_back({uint32_t(3 * i), uint32_t(3 * i + 1), uint32_t(3 * i + 2)});
+  }
+  return m;
+}
+
+/// `steps` time steps of the soup: every vertex of a moving triangle displaced at random per step
+/// (by up to `reach`), the static triangles (id % 3 == 0) left exactly in place.
+std::vector<std::shared_ptr<const Mesh>> deforming_steps(const Mesh& base, uint32_t steps, float reach,
+                                                         uint64_t seed) {
+  std::vector<std::shared_ptr<const Mesh>> out;
+  Rng rng(seed);
+  for (uint32_t k = 0; k < steps; ++k) {
+    Mesh m = base;
+    for (size_t v = 0; v < m.vertices.size(); ++v)
+      if ((v / 3) % 3 != 0 && k > 0) m.vertices[v] += reach * (rng.unit_cube() - vec3(0.5f));
+    out.push_back(std::make_shared<const Mesh>(std::move(m)));
+  }
+  return out;
+}
+
+/// Rays over box with random times: random ones, ones aimed at triangle centroids at their own time,
+/// axis-parallel ones, and rays at times 0 and 1 exactly.
+std::vector<Ray> timed_rays(const MotionTrianglePrims* prims, const AABB& box, size_t count, uint64_t seed) {
+  Rng rng(seed);
+  const vec3 lo = box.lo - 0.3f * box.extent(), hi = box.hi + 0.3f * box.extent();
+  std::vector<Ray> rays;
+  for (size_t i = 0; i < count; ++i) {
+    Ray r;
+    r.org = lo + rng.unit_cube() * (hi - lo);
+    r.dir = rng.unit_sphere();
+    r.time = i % 11 == 0 ? float(i % 2) : rng.uniform();
+    if (i % 3 == 1 && prims && prims->size()) {
+      const Triangle t = prims->triangle_at(rng.below(prims->size()), r.time);
+      r.dir = t.centroid() - r.org;
+    }
+    if (i % 7 == 2) r.dir = vec3(0.0f, 0.0f, (i % 2) ? 1.0f : -1.0f);
+    rays.push_back(r);
+  }
+  return rays;
+}
+
+/// Brute's hits at 1 thread, then `accel` at 1 and 2 threads (closest and occluded), byte for byte.
+void expect_same_as_brute(const Accelerator& accel, const Accelerator& brute, const std::vector<Ray>& rays,
+                          const std::string& what) {
+  std::vector<Hit> expected(rays.size());
+  trace_closest(brute, rays, expected, 1);
+  size_t found = 0;
+  for (const Hit& h : expected) found += h.found();
+  EXPECT_GT(found, rays.size() / 20) << what << ": too few hits to test anything";
+  for (int threads : {1, 2}) {
+    std::vector<Hit> hits(rays.size());
+    trace_closest(accel, rays, hits, threads);
+    const IdenticalResult r = compare_identical(expected, hits);
+    ASSERT_TRUE(r.identical()) << what << ", " << threads << " thread(s): " << r.differing << " of "
+                               << rays.size() << " rays differ (first " << r.first_differences.front() << ")";
+  }
+  std::vector<uint8_t> occluded(rays.size());
+  trace_occluded(accel, rays, occluded, 2);
+  for (size_t i = 0; i < rays.size(); ++i)
+    ASSERT_EQ(occluded[i] != 0, expected[i].found()) << what << ": occluded() differs on ray " << i;
+}
+
+TEST(MotionRayFile, VersionOneStaysByteForByteAndVersionTwoKeepsTimes) {
+  std::vector<Ray> rays = timed_rays(nullptr, {vec3(0), vec3(1)}, 50, 3);
+  const fs::path v1 = temp_path("v1.rays"), v2 = temp_path("v2.rays");
+  write_rays(v1.string(), rays);
+  write_rays(v2.string(), rays, RayFileVersion::kV2);
+  EXPECT_EQ(fs::file_size(v1), 16u + 50u * 32u);
+  EXPECT_EQ(fs::file_size(v2), 16u + 50u * 36u);
+  EXPECT_EQ(ray_record_bytes(v1.string()), 32u);
+  EXPECT_EQ(ray_record_bytes(v2.string()), 36u);
+  const std::vector<Ray> back1 = read_rays(v1.string()), back2 = read_rays(v2.string());
+  ASSERT_EQ(back1.size(), rays.size());
+  ASSERT_EQ(back2.size(), rays.size());
+  EXPECT_EQ(std::memcmp(back2.data(), rays.data(), rays.size() * sizeof(Ray)), 0);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_EQ(back1[i].time, 0.0f);
+    EXPECT_EQ(std::memcmp(&back1[i], &rays[i], 32), 0);
+  }
+  std::ifstream in(v1, std::ios::binary);
+  char magic[8];
+  in.read(magic, 8);
+  EXPECT_EQ(std::string(magic, 8), "ABRAYS01");
+  fs::remove(v1);
+  fs::remove(v2);
+}
+
+TEST(MotionRayFile, BadTimesAreBadInput) {
+  for (float bad : {std::nanf(""), -0.25f, 1.5f, kInf}) {
+    std::vector<Ray> rays(3);
+    rays[1].time = bad;
+    const fs::path p = temp_path("bad.rays");
+    write_rays(p.string(), rays, RayFileVersion::kV2);
+    try {
+      read_rays(p.string());
+      ADD_FAILURE() << "time " << bad << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("ray 1"), std::string::npos) << e.what();
+    }
+    fs::remove(p);
+  }
+}
+
+TEST(MotionPrims, InterpolationHitsTheStepsAndStaysInsideTheSweptBox) {
+  const Mesh base = soup(200, 5);
+  const auto steps = deforming_steps(base, 4, 0.3f, 6);
+  const MotionTrianglePrims prims(steps);
+  ASSERT_EQ(prims.size(), 200u);
+  for (size_t i = 0; i < prims.size(); ++i) {
+    EXPECT_EQ(prims.moves(i), i % 3 != 0);
+    for (uint32_t k = 0; k < 4; ++k) {
+      const Triangle at = prims.triangle_at(i, float(k) / 3.0f), step = steps[k]->triangle(i);
+      EXPECT_EQ(std::memcmp(&at, &step, sizeof(Triangle)), 0) << i << " step " << k;
+    }
+    for (int s = 0; s <= 200; ++s) {
+      const Triangle t = prims.triangle_at(i, float(s) / 200.0f);
+      const AABB b = prims.bounds(i);
+      for (const vec3& v : {t.v0, t.v1, t.v2}) ASSERT_TRUE(b.contains(v)) << i << " at " << s;
+    }
+  }
+}
+
+/// An instance of a unit cube spinning about a tilted axis by `degrees` over the shutter (with a
+/// translation), sampled at `steps` time steps.
+Instance spinning_instance(std::shared_ptr<const Accelerator> base, float degrees, uint32_t steps) {
+  Instance inst{base, glm::mat4(1.0f), glm::mat4(1.0f), 0, {}};
+  for (uint32_t k = 0; k < steps; ++k) {
+    const float f = float(k) / float(steps - 1);
+    glm::mat4 m = glm::translate(glm::mat4(1.0f), vec3(3.0f * f, 1.0f, -2.0f));
+    m = glm::rotate(m, glm::radians(degrees * f), glm::normalize(vec3(1, 2, 0.5f)));
+    inst.to_world_steps.push_back(glm::scale(m, vec3(1.0f + f, 0.5f, 1.5f)));
+  }
+  inst.to_world = inst.to_world_steps.front();
+  inst.to_object = glm::inverse(inst.to_world);
+  return inst;
+}
+
+TEST(MotionInstances, SampledPositionsStayInsideTheBoundsOverLargeRotations) {
+  Mesh cube;
+  for (int c = 0; c < 8; ++c) cube.vertices.push_back(vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1) - vec3(0.5f));
+  cube.triangles = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
+  auto base = make_accelerator(
+      "brute", std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(cube)), Params{});
+  base->build();
+  std::shared_ptr<const Accelerator> shared = std::move(base);
+  for (float degrees : {30.0f, 180.0f, 359.0f, 720.0f})
+    for (uint32_t steps : {2u, 3u, 9u}) {
+      const Instance inst = spinning_instance(shared, degrees, steps);
+      const AABB world = instance_world_bounds(inst);
+      for (int s = 0; s <= 1000; ++s) {
+        const glm::mat4 m = instance_to_world_at(inst, float(s) / 1000.0f);
+        for (const vec3& v : cube.vertices)
+          ASSERT_TRUE(world.contains(vec3(m * glm::vec4(v, 1.0f)))) << degrees << " " << steps << " " << s;
+      }
+    }
+}
+
+class MotionConformance : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MotionConformance, DeformingMeshes) {
+  for (uint32_t steps : {2u, 5u}) {
+    auto prims = std::make_shared<const MotionTrianglePrims>(deforming_steps(soup(400, 7), steps, 0.25f, 8));
+    auto accel = make_motion_accelerator(GetParam(), prims, Params{});
+    accel->build();
+    auto brute = make_motion_accelerator("brute", prims, Params{});
+    brute->build();
+    EXPECT_EQ(accel->bounds().lo, prims->bounds().lo);
+    expect_same_as_brute(*accel, *brute, timed_rays(prims.get(), prims->bounds(), 2000, steps),
+                         GetParam() + " over " + std::to_string(steps) + " steps");
+  }
+}
+
+/// Twelve instances over two bases (a deforming soup and a static one): every other one spinning.
+std::shared_ptr<const InstancePrims> moving_instances(std::shared_ptr<const Accelerator> moving,
+                                                      std::shared_ptr<const Accelerator> fixed) {
+  std::vector<Instance> list;
+  for (int i = 0; i < 12; ++i) {
+    auto base = i % 3 == 0 ? fixed : moving;
+    if (i % 2) {
+      Instance inst = spinning_instance(base, 40.0f * float(i), 2 + uint32_t(i % 4));
+      for (glm::mat4& m : inst.to_world_steps)
+        m = glm::translate(glm::mat4(1.0f), vec3(float(i % 4), 0, 0)) * m;
+      list.push_back(inst);
+    } else {
+      const glm::mat4 m = glm::translate(glm::mat4(1.0f), vec3(float(i % 4) * 1.5f, float(i / 4), 0.0f));
+      list.push_back({base, m, glm::inverse(m), 0, {}});
+    }
+  }
+  return std::make_shared<const InstancePrims>(std::move(list));
+}
+
+TEST_P(MotionConformance, MovingInstancesAtBothLevels) {
+  auto steps = deforming_steps(soup(150, 9), 3, 0.2f, 10);
+  auto motion = std::make_shared<const MotionTrianglePrims>(steps);
+  auto fixed = std::make_shared<const TrianglePrims>(steps.front());
+  auto built = [](std::unique_ptr<Accelerator> a) {
+    a->build();
+    return std::shared_ptr<const Accelerator>(std::move(a));
+  };
+  auto brute_moving = built(make_motion_accelerator("brute", motion, Params{}));
+  auto brute_fixed = built(make_accelerator("brute", fixed, Params{}));
+  auto all_brute = built(make_instance_accelerator("brute", moving_instances(brute_moving, brute_fixed), {}));
+  std::vector<Ray> rays = timed_rays(nullptr, all_brute->bounds(), 2000, 11);
+  const auto placed = moving_instances(brute_moving, brute_fixed);
+  Rng rng(12);
+  for (size_t k = 0; k < rays.size(); k += 2) {  // every other ray aimed into an instance at its time
+    const Instance& inst = placed->instance(rng.below(placed->size()));
+    const glm::mat4 m = inst.moves() ? instance_to_world_at(inst, rays[k].time) : inst.to_world;
+    const Triangle t = motion->triangle_at(rng.below(motion->size()), rays[k].time);
+    rays[k].dir = vec3(m * glm::vec4(t.centroid(), 1.0f)) - rays[k].org;
+  }
+  auto top = built(make_instance_accelerator(GetParam(), moving_instances(brute_moving, brute_fixed), {}));
+  expect_same_as_brute(*top, *all_brute, rays, GetParam() + " as top level");
+  auto bottom = built(
+      make_instance_accelerator("brute",
+                                moving_instances(built(make_motion_accelerator(GetParam(), motion, Params{})),
+                                                 built(make_accelerator(GetParam(), fixed, Params{}))),
+                                {}));
+  expect_same_as_brute(*bottom, *all_brute, rays, GetParam() + " as bottom level");
+}
+
+/// The shipped motion scene (datasets/scenes/motion.xml) at a frame inside the animation.
+std::shared_ptr<const Scene> motion_scene(float time = 0.3f) {
+  const Scene s = load_scene(std::string(ACCELBENCH_SOURCE_DIR) + "/datasets/scenes/motion.xml");
+  return std::make_shared<const Scene>(scene_at(s, time));
+}
+
+/// The scene's primary rays with times (the `motion` kind), plus rays at random times through its bounds.
+std::vector<Ray> scene_rays(const Scene& scene, const AABB& bounds, const Accelerator& brute) {
+  std::vector<Ray> rays = make_scene_rays(
+      scene, [&](std::span<const Ray> r, std::span<Hit> h) { brute.intersect(r, h); }, "motion", 1500, 4);
+  const std::vector<Ray> more = timed_rays(nullptr, bounds, 500, 5);
+  rays.insert(rays.end(), more.begin(), more.end());
+  return rays;
+}
+
+TEST(MotionScene, TheShippedSceneMovesAnInstanceAndDeformsMeshes) {
+  const auto scene = motion_scene();
+  const SceneMotion motion = scene_motion(*scene);
+  ASSERT_TRUE(motion.any());
+  EXPECT_EQ(motion.step_times.size(), 5u);
+  size_t moving_meshes = 0, moving_instances = 0;
+  for (const auto& m : motion.meshes) moving_meshes += !m.empty();
+  for (const auto& i : motion.instances) moving_instances += !i.empty();
+  EXPECT_EQ(moving_meshes, 2u);
+  EXPECT_EQ(moving_instances, 1u);
+  EXPECT_FLOAT_EQ(shutter_scene_time(*scene, 0.0f), 0.3f);
+  EXPECT_FLOAT_EQ(shutter_scene_time(*scene, 1.0f), 0.35f);
+}
+
+TEST_P(MotionConformance, ShippedSceneTwoLevelAndFlattened) {
+  const auto scene = motion_scene();
+  auto brute = make_scene_accelerator(scene, "brute", Params{});
+  brute->build();
+  const std::vector<Ray> rays = scene_rays(*scene, brute->bounds(), *brute);
+  auto accel = make_scene_accelerator(scene, GetParam(), Params{});
+  accel->build();
+  expect_same_as_brute(*accel, *brute, rays, GetParam() + " two-level");
+  auto flat = std::make_shared<const MotionTrianglePrims>(flatten_scene_motion(*scene, scene_motion(*scene)));
+  auto flat_brute = make_motion_accelerator("brute", flat, Params{});
+  flat_brute->build();
+  auto flat_accel = make_motion_accelerator(GetParam(), flat, Params{});
+  flat_accel->build();
+  expect_same_as_brute(*flat_accel, *flat_brute, rays, GetParam() + " flattened");
+}
+
+TEST(MotionScene, StaticScenesAndAClosedShutterIgnoreRayTimes) {
+  Scene closed = *motion_scene();
+  closed.camera.shutter_close = closed.camera.shutter_open;
+  auto scene = std::make_shared<const Scene>(closed);
+  ASSERT_FALSE(scene_motion(*scene).any());
+  for (const std::string name : {"brute", "bvh-sah", "grid"}) {
+    auto accel = make_scene_accelerator(scene, name, Params{});
+    accel->build();
+    std::vector<Ray> rays = scene_rays(*scene, accel->bounds(), *accel), at_zero = rays;
+    for (Ray& r : at_zero) r.time = 0.0f;
+    std::vector<Hit> a(rays.size()), b(rays.size());
+    trace_closest(*accel, rays, a, 2);
+    trace_closest(*accel, at_zero, b, 2);
+    EXPECT_TRUE(compare_identical(a, b).identical()) << name;
+  }
+}
+
+TEST(MotionScene, RenderIsTheSameOnAnyThreadCountAndShowsBlur) {
+  const auto scene = motion_scene();
+  auto accel = make_scene_accelerator(scene, "bvh-motion", Params{});
+  accel->build();
+  RenderOptions o = render_options(*scene);
+  o.width = 48;
+  o.height = 36;
+  o.spp = 4;
+  o.threads = 1;
+  const Image one = render(*scene, *accel, o);
+  o.threads = 2;
+  const Image two = render(*scene, *accel, o);
+  EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(vec3)), 0);
+  Scene closed = *scene;
+  closed.camera.shutter_close = closed.camera.shutter_open;
+  auto still = std::make_shared<const Scene>(closed);
+  auto still_accel = make_scene_accelerator(still, "bvh-motion", Params{});
+  still_accel->build();
+  const Image sharp = render(*still, *still_accel, o);
+  EXPECT_NE(std::memcmp(one.pixels.data(), sharp.pixels.data(), one.pixels.size() * sizeof(vec3)), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, MotionConformance, ::testing::ValuesIn(structure_names()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string s = info.param;
+                           for (char& c : s)
+                             if (c == '-') c = '_';
+                           return s;
+                         });
+
+}  // namespace
+}  // namespace ab
