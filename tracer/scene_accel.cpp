@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "accel/core/error.h"
 #include "accel/core/registry.h"
 
 namespace ab {
@@ -20,16 +21,22 @@ Params level_params(const Params& params, const std::string& prefix, const std::
 SceneAccelerator::SceneAccelerator(std::shared_ptr<const Scene> scene, std::string top, std::string bottom,
                                    const Params& params)
     : scene_(std::move(scene)),
+      motion_(scene_motion(*scene_)),
       top_name_(std::move(top)),
       bottom_name_(std::move(bottom)),
       top_params_(level_params(params, "top", "bottom")),
       bottom_params_(level_params(params, "bottom", "top")) {
-  for (const SceneMesh& m : scene_->meshes)
-    bottoms_.push_back(
-        make_accelerator(bottom_name_, std::make_shared<TrianglePrims>(m.mesh), bottom_params_));
+  for (size_t m = 0; m < scene_->meshes.size(); ++m) {
+    if (!motion_.meshes[m].empty())
+      bottoms_.push_back(make_motion_accelerator(
+          bottom_name_, std::make_shared<MotionTrianglePrims>(motion_.meshes[m]), bottom_params_));
+    else
+      bottoms_.push_back(make_accelerator(
+          bottom_name_, std::make_shared<TrianglePrims>(scene_->meshes[m].mesh), bottom_params_));
+  }
   // Checks the top-level name and parameters now (the real top is made once the bottoms are built).
   make_instance_accelerator(top_name_, std::make_shared<InstancePrims>(std::vector<Instance>{}), top_params_);
-  bounds_ = scene_->world_bounds();
+  bounds_ = motion_.any() ? motion_world_bounds(*scene_, motion_) : scene_->world_bounds();
 }
 
 std::string SceneAccelerator::name() const {
@@ -54,8 +61,11 @@ void SceneAccelerator::do_build() {
 std::vector<Instance> SceneAccelerator::make_instances() const {
   std::vector<Instance> instances;
   instances.reserve(scene_->instances.size());
-  for (const SceneInstance& si : scene_->instances)
-    instances.push_back({bottoms_[si.mesh], si.transform.to_world, si.transform.to_object, si.mesh});
+  for (size_t i = 0; i < scene_->instances.size(); ++i) {
+    const SceneInstance& si = scene_->instances[i];
+    instances.push_back({bottoms_[si.mesh], si.transform.to_world, si.transform.to_object, si.mesh,
+                         i < motion_.instances.size() ? motion_.instances[i] : std::vector<glm::mat4>{}});
+  }
   return instances;
 }
 
@@ -115,11 +125,14 @@ std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene>
   const std::string t = top.empty() ? name : top;
   const std::string b = bottom.empty() ? name : bottom;
   if (t == kEmbreeName && b == kEmbreeName) {
+    SceneMotion motion = scene_motion(*scene);  // Embree's motion blur: the same time steps
     std::vector<std::shared_ptr<const Mesh>> meshes;
     std::vector<EmbreeInstanceInput> instances;
     embree_scene_inputs(*scene, meshes, instances);
+    for (size_t i = 0; i < instances.size(); ++i)
+      instances[i].to_world_steps = std::move(motion.instances[i]);
     Params p = params;
-    return make_embree_scene(std::move(meshes), std::move(instances), p);
+    return make_embree_scene(std::move(meshes), std::move(instances), p, std::move(motion.meshes));
   }
   return std::make_unique<SceneAccelerator>(std::move(scene), t, b, params);
 }

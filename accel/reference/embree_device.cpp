@@ -63,19 +63,27 @@ RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFl
   return commit_mesh_scene(mesh, quality, flags, quality);
 }
 
-RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags,
-                           RTCBuildQuality geometry_quality) {
+namespace {
+
+/// A committed scene of one triangle geometry with a vertex buffer per entry of `steps` (one: static).
+RTCScene commit_steps_scene(const std::vector<const Mesh*>& steps, RTCBuildQuality quality,
+                            RTCSceneFlags flags, RTCBuildQuality geometry_quality) {
   RTCDevice device = embree_device();
   RTCScene scene = rtcNewScene(device);
   rtcSetSceneFlags(scene, flags);
   rtcSetSceneBuildQuality(scene, quality);
+  const Mesh& mesh = *steps.front();
   if (mesh.size() > 0) {
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetGeometryBuildQuality(geom, geometry_quality);
+    if (steps.size() > 1) rtcSetGeometryTimeStepCount(geom, static_cast<unsigned>(steps.size()));
     // Embree reads vertex buffers with 16-byte loads: allocated through it, the buffer is padded for that.
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, mesh.vertices.size()));
-    std::memcpy(vertices, mesh.vertices.data(), sizeof(float) * 3 * mesh.vertices.size());
+    for (size_t k = 0; k < steps.size(); ++k) {
+      auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, unsigned(k),
+                                                                   RTC_FORMAT_FLOAT3, sizeof(float) * 3,
+                                                                   steps[k]->vertices.size()));
+      std::memcpy(vertices, steps[k]->vertices.data(), sizeof(float) * 3 * steps[k]->vertices.size());
+    }
     auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
         geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, mesh.size()));
     std::memcpy(indices, mesh.triangles.data(), sizeof(uint32_t) * 3 * mesh.size());
@@ -89,6 +97,20 @@ RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFl
     throw InputError("embree: mesh build failed");
   }
   return scene;
+}
+
+}  // namespace
+
+RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFlags flags,
+                           RTCBuildQuality geometry_quality) {
+  return commit_steps_scene({&mesh}, quality, flags, geometry_quality);
+}
+
+RTCScene commit_motion_mesh_scene(const std::vector<std::shared_ptr<const Mesh>>& steps,
+                                  RTCBuildQuality quality, RTCSceneFlags flags) {
+  std::vector<const Mesh*> meshes;
+  for (const auto& m : steps) meshes.push_back(m.get());
+  return commit_steps_scene(meshes, quality, flags, quality);
 }
 
 void update_mesh_vertices(RTCScene scene, const Mesh& mesh) {

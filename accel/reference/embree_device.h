@@ -6,6 +6,8 @@
 #include <embree3/rtcore.h>
 
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include "accel/core/mesh.h"
 #include "accel/core/params.h"
@@ -46,11 +48,17 @@ RTCScene commit_mesh_scene(const Mesh& mesh, RTCBuildQuality quality, RTCSceneFl
 /// in place, and commits the geometry and the scene again: a refit when the geometry's quality is
 /// RTC_BUILD_QUALITY_REFIT, a rebuild of the scene's quality otherwise. Nothing happens for an empty mesh.
 void update_mesh_vertices(RTCScene scene, const Mesh& mesh);
+/// A committed Embree scene holding a deforming mesh as geometry 0: one vertex buffer per time step
+/// (rtcSetGeometryTimeStepCount; Embree interpolates them linearly per segment at the ray's time), the
+/// triangle list of the first step. Throws InputError when Embree reports an error.
+RTCScene commit_motion_mesh_scene(const std::vector<std::shared_ptr<const Mesh>>& steps,
+                                  RTCBuildQuality quality, RTCSceneFlags flags);
+
 /// Throws InputError naming `what` when the device has recorded an error (and clears it).
 void check_embree_error(const char* what);
 
 /// Converts a ray to Embree's RTCRayHit: tnear = tmin, tfar = `tfar` (the ray's tmax, or the best hit so
-/// far), every mask bit, time 0, no hit.
+/// far), every mask bit, the ray's time (motion blur; 0 for ABRAYS01 rays), no hit.
 inline RTCRayHit to_embree(const Ray& r, float tfar) {
   RTCRayHit rh;
   rh.ray.org_x = r.org.x;
@@ -61,7 +69,7 @@ inline RTCRayHit to_embree(const Ray& r, float tfar) {
   rh.ray.dir_z = r.dir.z;
   rh.ray.tnear = r.tmin;
   rh.ray.tfar = tfar;
-  rh.ray.time = 0.0f;
+  rh.ray.time = r.time;
   rh.ray.mask = 0xFFFFFFFFu;
   rh.ray.id = 0;
   rh.ray.flags = 0;

@@ -16,11 +16,20 @@ namespace {
 class EmbreeScene final : public Accelerator, public EmbreeSceneFrames {
  public:
   EmbreeScene(std::vector<std::shared_ptr<const Mesh>> meshes, std::vector<EmbreeInstanceInput> instances,
-              const EmbreeConfig& config)
-      : meshes_(std::move(meshes)), instances_(std::move(instances)), config_(config) {
+              const EmbreeConfig& config, std::vector<std::vector<std::shared_ptr<const Mesh>>> mesh_steps)
+      : meshes_(std::move(meshes)),
+        mesh_steps_(std::move(mesh_steps)),
+        instances_(std::move(instances)),
+        config_(config) {
+    mesh_steps_.resize(meshes_.size());
     for (const auto& inst : instances_) {
       if (inst.mesh >= meshes_.size()) throw InputError("embree: instance of a missing mesh");
-      bounds_.extend(transform_bounds(meshes_[inst.mesh]->bounds(), inst.to_world));
+      std::vector<const Mesh*> shapes{meshes_[inst.mesh].get()};
+      for (const auto& m : mesh_steps_[inst.mesh]) shapes.push_back(m.get());
+      for (const Mesh* m : shapes) {
+        bounds_.extend(transform_bounds(m->bounds(), inst.to_world));
+        for (const glm::mat4& s : inst.to_world_steps) bounds_.extend(transform_bounds(m->bounds(), s));
+      }
     }
   }
   ~EmbreeScene() override { release(); }
@@ -66,6 +75,7 @@ class EmbreeScene final : public Accelerator, public EmbreeSceneFrames {
   RTCBuildQuality scene_quality() const { return for_refit_ ? RTC_BUILD_QUALITY_LOW : config_.quality; }
 
   std::vector<std::shared_ptr<const Mesh>> meshes_;
+  std::vector<std::vector<std::shared_ptr<const Mesh>>> mesh_steps_;  ///< per mesh: its time steps, or none
   std::vector<EmbreeInstanceInput> instances_;
   EmbreeConfig config_;
   AABB bounds_;
@@ -78,8 +88,11 @@ void EmbreeScene::do_build() {
   release();
   const int64_t bytes_before = embree_bytes_in_use();
   const RTCBuildQuality geometry_quality = for_refit_ ? RTC_BUILD_QUALITY_REFIT : config_.quality;
-  for (const auto& m : meshes_)
-    bottoms_.push_back(commit_mesh_scene(*m, scene_quality(), flags(), geometry_quality));
+  for (size_t m = 0; m < meshes_.size(); ++m)
+    bottoms_.push_back(
+        mesh_steps_[m].empty()
+            ? commit_mesh_scene(*meshes_[m], scene_quality(), flags(), geometry_quality)
+            : commit_motion_mesh_scene(mesh_steps_[m], config_.quality, RTC_SCENE_FLAG_ROBUST));
   commit_top();
   const int64_t grown = embree_bytes_in_use() - bytes_before;
   stats_.bytes = grown > 0 ? static_cast<uint64_t>(grown) : 0;
@@ -94,8 +107,12 @@ void EmbreeScene::commit_top() {
   for (size_t i = 0; i < instances_.size(); ++i) {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(g, bottoms_[instances_[i].mesh]);
-    rtcSetGeometryTimeStepCount(g, 1);
-    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, glm::value_ptr(instances_[i].to_world));
+    const std::vector<glm::mat4>& steps = instances_[i].to_world_steps;
+    rtcSetGeometryTimeStepCount(g, steps.empty() ? 1u : static_cast<unsigned>(steps.size()));
+    if (steps.empty())
+      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, glm::value_ptr(instances_[i].to_world));
+    for (size_t k = 0; k < steps.size(); ++k)
+      rtcSetGeometryTransform(g, unsigned(k), RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, glm::value_ptr(steps[k]));
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(top_, g, static_cast<unsigned>(i));
     rtcReleaseGeometry(g);
@@ -112,7 +129,9 @@ bool EmbreeScene::refit_frame(const std::vector<std::shared_ptr<const Mesh>>& me
     if (meshes[m]->vertices.size() != meshes_[m]->vertices.size() || meshes[m]->size() != meshes_[m]->size())
       return false;
   for (size_t i = 0; i < instances.size(); ++i)
-    if (instances[i].mesh != instances_[i].mesh) return false;
+    if (instances[i].mesh != instances_[i].mesh || !instances[i].to_world_steps.empty()) return false;
+  for (const auto& steps : mesh_steps_)
+    if (!steps.empty()) return false;  // motion blur: rebuilt every frame
   const auto start = std::chrono::steady_clock::now();
   for (size_t m = 0; m < meshes.size(); ++m) {
     if (meshes[m] != meshes_[m]) update_mesh_vertices(bottoms_[m], *meshes[m]);
@@ -175,11 +194,13 @@ bool EmbreeScene::occluded_one(const Ray& ray, RayCounters*) const {
 
 }  // namespace
 
-std::unique_ptr<Accelerator> make_embree_scene(std::vector<std::shared_ptr<const Mesh>> meshes,
-                                               std::vector<EmbreeInstanceInput> instances, Params& params) {
+std::unique_ptr<Accelerator> make_embree_scene(
+    std::vector<std::shared_ptr<const Mesh>> meshes, std::vector<EmbreeInstanceInput> instances,
+    Params& params, std::vector<std::vector<std::shared_ptr<const Mesh>>> mesh_steps) {
   const EmbreeConfig config = EmbreeConfig::read(params);
   params.finish(kEmbreeName);
-  auto accel = std::make_unique<EmbreeScene>(std::move(meshes), std::move(instances), config);
+  auto accel =
+      std::make_unique<EmbreeScene>(std::move(meshes), std::move(instances), config, std::move(mesh_steps));
   accel->identify(kEmbreeName, params.effective());
   return accel;
 }

@@ -13,10 +13,12 @@
 
 namespace ab {
 
-/// One instance: a base mesh index and its object-to-world matrix.
+/// One instance: a base mesh index and its object-to-world matrix (and, when it moves during the shutter,
+/// that matrix at each time step: Embree interpolates FLOAT4X4 time steps linearly, as matrix_at does).
 struct EmbreeInstanceInput {
-  uint32_t mesh = 0;         ///< index of the base mesh
-  glm::mat4 to_world{1.0f};  ///< object-to-world matrix
+  uint32_t mesh = 0;                      ///< index of the base mesh
+  glm::mat4 to_world{1.0f};               ///< object-to-world matrix
+  std::vector<glm::mat4> to_world_steps;  ///< at the shutter's time steps (empty: does not move)
 };
 
 /// What the `refit` strategy (tracer/update_strategy.h) asks of an Embree scene: built for refitting, as
@@ -40,7 +42,9 @@ class EmbreeSceneFrames {
 /// instID is the contract's `inst`). Parameters: EmbreeConfig (quality=low|medium|high, default medium),
 /// checked and recorded as the registry does for every structure (name `embree`, effective config). The
 /// result is also an EmbreeSceneFrames.
-std::unique_ptr<Accelerator> make_embree_scene(std::vector<std::shared_ptr<const Mesh>> meshes,
-                                               std::vector<EmbreeInstanceInput> instances, Params& params);
+/// `mesh_steps[m]`, when given and not empty, holds base mesh m at each time step (motion blur).
+std::unique_ptr<Accelerator> make_embree_scene(
+    std::vector<std::shared_ptr<const Mesh>> meshes, std::vector<EmbreeInstanceInput> instances,
+    Params& params, std::vector<std::vector<std::shared_ptr<const Mesh>>> mesh_steps = {});
 
 }  // namespace ab
