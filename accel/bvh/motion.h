@@ -11,6 +11,7 @@
 #include "accel/bvh/motion_build.h"
 #include "accel/bvh/motion_node.h"
 #include "accel/bvh/walk2.h"
+#include "accel/common/leaf_refs.h"
 #include "accel/common/tree_stats.h"
 #include "accel/core/accelerator.h"
 #include "accel/core/box_test.h"
@@ -66,8 +67,7 @@ class BvhMotion final : public AcceleratorBase<BvhMotion<P>> {
     if (nodes_.empty()) return;
     const auto limit = [&] { return std::min(ray.tmax, best.t); };
     const auto leaf = [&](uint32_t first, uint32_t count) {
-      for (uint32_t k = first, e = first + count; k < e; ++k)
-        prims_->template intersect<kCount>(refs_[k], ray, best, inst, c);
+      refs_.template intersect<kCount>(*prims_, first, count, ray, best, inst, c);
       return false;
     };
     walk_bvh2<kCount, true>(nodes_.data(), ray, limit, leaf, c);
@@ -78,9 +78,7 @@ class BvhMotion final : public AcceleratorBase<BvhMotion<P>> {
     if (nodes_.empty()) return false;
     const auto limit = [&] { return ray.tmax; };
     const auto leaf = [&](uint32_t first, uint32_t count) {
-      for (uint32_t k = first, e = first + count; k < e; ++k)
-        if (prims_->template occluded<kCount>(refs_[k], ray, c)) return true;
-      return false;
+      return refs_.template occluded<kCount>(*prims_, first, count, ray, c);
     };
     return walk_bvh2<kCount, false>(nodes_.data(), ray, limit, leaf, c);
   }
@@ -94,7 +92,7 @@ class BvhMotion final : public AcceleratorBase<BvhMotion<P>> {
     s.max_depth = config_.max_depth;
     MotionBvhBuild result = MotionBvhBuilder<P>(*prims_, s).build();
     nodes_ = std::move(result.nodes);
-    refs_ = std::move(result.refs);
+    refs_.assign(*prims_, std::move(result.refs), LeafCopies::kAuto);  // triangles copied into leaf order
   }
   void gather_stats(BuildStats& stats) const override {
     stats.primitives = prims_->size();
@@ -103,14 +101,14 @@ class BvhMotion final : public AcceleratorBase<BvhMotion<P>> {
     for (size_t n = 0; n < nodes_.size(); ++n)
       temporal += !nodes_[n].is_leaf() && nodes_[nodes_[n].offset].t1 < nodes_[n].t1;
     stats.extra["temporal_splits"] = temporal;
-    stats.bytes = nodes_.size() * sizeof(MotionBvhNode) + refs_.size() * sizeof(uint32_t);
+    stats.bytes = nodes_.size() * sizeof(MotionBvhNode) + refs_.bytes();
   }
 
  private:
   std::shared_ptr<const P> prims_;
   Config config_;
   std::vector<MotionBvhNode> nodes_;
-  std::vector<uint32_t> refs_;
+  LeafRefs<P> refs_;
 };
 
 }  // namespace ab

@@ -10,7 +10,7 @@
 namespace ab {
 
 /// Relative widening of a node's end boxes: 2^-18 of the largest magnitude of its corners per axis. The box
-/// interpolated at a ray's time differs from the exact line by the rounding of (1 - f) a + f b and of f
+/// interpolated at a ray's time differs from the exact line by the rounding of a + f (b - a) and of f
 /// (a few ulps of max |a|, |b|), and a primitive interpolated by its own segment fraction differs from its
 /// exact position by a few ulps of its coordinates and of their motion (at most 2 max |a|, |b|): under 2^-20
 /// of the magnitude together, so 2^-18 holds it four times over.
@@ -18,13 +18,14 @@ inline constexpr float kMotionBoxEps = 0x1p-18f;
 
 struct MotionPairTest;
 
-/// One node (64 bytes): the linear bound's end boxes over [t0, t1]. Interior (count == 0): the children are
-/// the sibling pair `offset`, `offset + 1`; leaf (count > 0): references [offset, offset + count), as
-/// BvhNode.
+/// One node (64 bytes): the linear bound over [t0, t1] as its start box and the motion of its corners to the
+/// end box (lo1 = lo0 + dlo; a static node's motion is 0 and its box at any time is exactly lo0, hi0).
+/// Interior (count == 0): the children are the sibling pair `offset`, `offset + 1`; leaf (count > 0):
+/// references [offset, offset + count), as BvhNode.
 struct MotionBvhNode {
   using PairTest = MotionPairTest;  ///< the ray test of a sibling pair, for walk_bvh2
 
-  vec3 lo0, hi0, lo1, hi1;
+  vec3 lo0, hi0, dlo, dhi;
   float t0 = 0.0f, t1 = 1.0f;
   uint32_t offset = 0;
   uint32_t count = 0;
@@ -35,7 +36,8 @@ struct MotionBvhNode {
     const vec3 mag = glm::max(glm::max(glm::abs(lb.at0.lo), glm::abs(lb.at0.hi)),
                               glm::max(glm::abs(lb.at1.lo), glm::abs(lb.at1.hi)));
     const vec3 m = mag * kMotionBoxEps;
-    n.lo0 = lb.at0.lo - m, n.hi0 = lb.at0.hi + m, n.lo1 = lb.at1.lo - m, n.hi1 = lb.at1.hi + m;
+    n.lo0 = lb.at0.lo - m, n.hi0 = lb.at0.hi + m;
+    n.dlo = (lb.at1.lo - m) - n.lo0, n.dhi = (lb.at1.hi + m) - n.hi0;
     n.t0 = t0, n.t1 = t1;
     return n;
   }
@@ -46,10 +48,10 @@ struct MotionBvhNode {
   /// The box at time t (in the range).
   AABB box_at(float t) const {
     const float f = t0 == 0.0f && t1 == 1.0f ? t : (t - t0) / (t1 - t0);  // most nodes span the shutter
-    return {(1.0f - f) * lo0 + f * lo1, (1.0f - f) * hi0 + f * hi1};
+    return {lo0 + f * dlo, hi0 + f * dhi};
   }
   /// A box holding the node over its whole range.
-  AABB hull() const { return {glm::min(lo0, lo1), glm::max(hi0, hi1)}; }
+  AABB hull() const { return {glm::min(lo0, lo0 + dlo), glm::max(hi0, hi0 + dhi)}; }
 };
 static_assert(sizeof(MotionBvhNode) == 64);
 
