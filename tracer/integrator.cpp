@@ -70,10 +70,11 @@ class Tracer {
     const bool front = glm::dot(ng, d) < 0.0f;
     const vec3 nf = front ? ng : -ng;
     const Material& m = scene_.materials[scene_.instances[hit.inst].material];
-    if (m.type == Material::Type::kDiffuse) return diffuse(p, nf, m, depth, diffuse_left, s, n);
+    if (m.type == Material::Type::kDiffuse) return diffuse(p, nf, m, depth, diffuse_left, ray.time, s, n);
     if (depth >= opt_.max_depth) return vec3(0.0f);
     Ray next;
     next.tmin = 0.0f;
+    next.time = ray.time;
     const vec3 r = d - 2.0f * glm::dot(d, nf) * nf;
     next.org = p + eps_ * nf;
     next.dir = r;
@@ -119,12 +120,14 @@ class Tracer {
     next.dir = eta * d + (eta * cosi - cost) * nf;
   }
 
-  vec3 diffuse(const vec3& p, const vec3& nf, const Material& m, int depth, int diffuse_left, PixelSampler& s,
-               RenderCounts& n) const {
-    vec3 l = scene_.render.ambient + direct(p, nf, s, n) * kInvPi;
+  /// Diffuse shading at p, every ray it casts at the camera ray's `time` (motion blur).
+  vec3 diffuse(const vec3& p, const vec3& nf, const Material& m, int depth, int diffuse_left, float time,
+               PixelSampler& s, RenderCounts& n) const {
+    vec3 l = scene_.render.ambient + direct(p, nf, time, s, n) * kInvPi;
     if (diffuse_left > 0 && depth < opt_.max_depth) {
       const glm::vec2 u = s.next2();
       Ray next;
+      next.time = time;
       next.org = p + eps_ * nf;
       next.dir = sample_cosine_hemisphere(nf, u.x, u.y);
       ++n.secondary_rays;
@@ -134,14 +137,14 @@ class Tracer {
   }
 
   /// Irradiance from the lights (point lights exactly, area lights by one sample each).
-  vec3 direct(const vec3& p, const vec3& nf, PixelSampler& s, RenderCounts& n) const {
+  vec3 direct(const vec3& p, const vec3& nf, float time, PixelSampler& s, RenderCounts& n) const {
     vec3 e(0.0f);
     const vec3 org = p + eps_ * nf;
     for (const PointLight& l : scene_.point_lights) {
       const vec3 w = l.position - org;
       const float d2 = glm::dot(w, w);
       const float c = glm::dot(nf, w);
-      if (c > 0.0f && visible(org, w, n)) e += l.intensity * (c / std::sqrt(d2)) / d2;
+      if (c > 0.0f && visible(org, w, time, n)) e += l.intensity * (c / std::sqrt(d2)) / d2;
     }
     for (const AreaLight& l : scene_.area_lights) {
       const glm::vec2 u = s.next2();
@@ -149,14 +152,15 @@ class Tracer {
       const float d2 = glm::dot(w, w);
       const float cs = glm::dot(nf, w);
       const float cl = -glm::dot(w, l.normal_area());  // |w| * cos_l * area
-      if (cs > 0.0f && cl > 0.0f && visible(org, w, n)) e += l.radiance * (cs * cl / (d2 * d2));
+      if (cs > 0.0f && cl > 0.0f && visible(org, w, time, n)) e += l.radiance * (cs * cl / (d2 * d2));
     }
     return e;
   }
 
-  bool visible(const vec3& org, const vec3& w, RenderCounts& n) const {
+  bool visible(const vec3& org, const vec3& w, float time, RenderCounts& n) const {
     ++n.shadow_rays;
     Ray r;
+    r.time = time;
     r.org = org;
     r.dir = w;
     r.tmin = 0.0f;
@@ -193,6 +197,23 @@ void for_each_pixel(const RenderOptions& opt, F&& f) {
   });
 }
 
+/// The camera ray's time of sample i of spp in pixel `pixel`: stratified over the shutter, stratum i rotated
+/// by a per-pixel offset (Cranley and Patterson 1976) and jittered, from a generator of its own (the pixel
+/// sampler's stream is left as it is), so the same on any thread count; 0 when the shutter is closed.
+float sample_time(const Scene& scene, uint64_t seed, uint64_t pixel, int i, int spp) {
+  if (!scene.camera.has_shutter()) return 0.0f;
+  Rng rotation(seed ^ 0x5DEECE66DULL, pixel);
+  const uint64_t offset = rotation.below(uint32_t(spp));
+  Rng jitter(seed ^ 0x2545F4914F6CDD1DULL, pixel * 65537ULL + uint64_t(i));
+  return std::min((float((uint64_t(i) + offset) % uint64_t(spp)) + jitter.uniform()) / float(spp), 1.0f);
+}
+
+/// A camera ray at a time.
+Ray timed(Ray r, float time) {
+  r.time = time;
+  return r;
+}
+
 }  // namespace
 
 RenderOptions render_options(const Scene& scene) {
@@ -220,8 +241,10 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
       const glm::vec2 px = s.next2();
       const glm::vec2 lens = s.next2();
       ++n.camera_rays;
-      sum += tracer.radiance(camera.generate(float(x) + px.x, float(y) + px.y, lens.x, lens.y), 0,
-                             opt.diffuse_depth, true, s, n);
+      const float time =
+          sample_time(scene, opt.seed, uint64_t(y) * uint64_t(opt.width) + uint64_t(x), i, opt.spp);
+      sum += tracer.radiance(timed(camera.generate(float(x) + px.x, float(y) + px.y, lens.x, lens.y), time),
+                             0, opt.diffuse_depth, true, s, n);
     }
     image.at(x, y) = sum / float(opt.spp);
     std::lock_guard<std::mutex> lock(counts_mutex);
@@ -245,8 +268,10 @@ std::vector<float> render_work(const Scene& scene, const Accelerator& accel, con
       const glm::vec2 px = s.next2();
       const glm::vec2 lens = s.next2();
       Hit hit;
-      accel.intersect_one(camera.generate(float(x) + px.x, float(y) + px.y, lens.x, lens.y), hit, kInvalidId,
-                          &c);
+      const float time =
+          sample_time(scene, opt.seed, uint64_t(y) * uint64_t(opt.width) + uint64_t(x), i, opt.spp);
+      accel.intersect_one(timed(camera.generate(float(x) + px.x, float(y) + px.y, lens.x, lens.y), time), hit,
+                          kInvalidId, &c);
     }
     const uint64_t v = metric == HeatmapMetric::kNodes ? c.nodes : c.prims;
     work[size_t(y) * size_t(opt.width) + size_t(x)] = float(double(v) / double(opt.spp));
