@@ -9,6 +9,18 @@ std::vector<AcceleratorInfo>& table() {
   static std::vector<AcceleratorInfo> t;
   return t;
 }
+/// Creates through one of info's factories (throws UnknownAccelerator saying `missing` when it is empty),
+/// then checks the parameters and records the name and the effective configuration.
+template <class Factory, class Prims>
+std::unique_ptr<Accelerator> create_with(const AcceleratorInfo& info, const Factory& factory, Prims prims,
+                                         Params& params, const std::string& missing) {
+  if (!factory) throw UnknownAccelerator("accelerator '" + info.name + "' " + missing);
+  auto accel = factory(std::move(prims), params);
+  params.finish(info.name);
+  accel->identify(info.name, params.effective());
+  return accel;
+}
+
 }  // namespace
 
 Registrar::Registrar(AcceleratorInfo info) {
@@ -34,10 +46,7 @@ const AcceleratorInfo& find_accelerator(const std::string& name) {
 std::unique_ptr<Accelerator> make_accelerator(const std::string& name,
                                               std::shared_ptr<const TrianglePrims> prims, Params params) {
   const AcceleratorInfo& info = find_accelerator(name);
-  auto accel = info.make_for_mesh(std::move(prims), params);
-  params.finish(name);
-  accel->identify(info.name, params.effective());
-  return accel;
+  return create_with(info, info.make_for_mesh, std::move(prims), params, "");
 }
 
 std::shared_ptr<const TrianglePrims> one_triangle_prims() {
@@ -55,28 +64,16 @@ std::unique_ptr<Accelerator> make_instance_accelerator(const std::string& name,
                                                        std::shared_ptr<const InstancePrims> prims,
                                                        Params params) {
   const AcceleratorInfo& info = find_accelerator(name);
-  if (!info.make_for_instances)
-    throw UnknownAccelerator("accelerator '" + name + "' cannot serve as the top level of a scene");
-  auto accel = info.make_for_instances(std::move(prims), params);
-  params.finish(name);
-  accel->identify(info.name, params.effective());
-  return accel;
+  return create_with(info, info.make_for_instances, std::move(prims), params,
+                     "cannot serve as the top level of a scene");
 }
-
-}  // namespace ab
-
-namespace ab {
 
 std::unique_ptr<Accelerator> make_motion_accelerator(const std::string& name,
                                                      std::shared_ptr<const MotionTrianglePrims> prims,
                                                      Params params) {
   const AcceleratorInfo& info = find_accelerator(name);
-  if (!info.make_for_motion_mesh)
-    throw UnknownAccelerator("accelerator '" + name + "' cannot hold a moving mesh (motion blur)");
-  auto accel = info.make_for_motion_mesh(std::move(prims), params);
-  params.finish(name);
-  accel->identify(info.name, params.effective());
-  return accel;
+  return create_with(info, info.make_for_motion_mesh, std::move(prims), params,
+                     "cannot hold a moving mesh (motion blur)");
 }
 
 }  // namespace ab
