@@ -3,7 +3,8 @@
 // refines, pbrt-v3; the reference budget as a safety net, reported as extra.budget_exhausted) and still
 // give brute's hits; the octree's depth limit grows with log N. The budget (build_with_budget) never
 // triggers on ordinary inputs, bounds every spatial structure's references on any input, and gives the same
-// tree for any thread count; kdtree-sah splits large overlapping triangles (max_leaf).
+// tree for any thread count; kdtree-sah splits large overlapping triangles (max_leaf); the BSP tree's shaves
+// are bad refines.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -164,9 +165,21 @@ TEST(Termination, BadRefinesStopLargeTrianglesAmongDegenerateOnes) {
   }
 }
 
+TEST(Termination, BspShavesAreBadRefines) {
+  // Large overlapping triangles: the SAH shaves the cell again and again (each cut keeps nearly every
+  // triangle on one side); the bad-refine limit stops that, with fewer nodes and the same hits.
+  const Mesh mesh = generate_mesh("large", 3000, 10, Params());
+  const std::map<std::string, std::string> off{{"bad_refines", "0"}, {"ref_budget", "1000"}};
+  const BuildStats with = built("bsp", mesh, {{"ref_budget", "1000"}})->stats();
+  const BuildStats without = built("bsp", mesh, off)->stats();
+  EXPECT_LT(with.nodes, without.nodes);
+  EXPECT_EQ(count_differences("bsp", mesh, adversarial_rays(mesh, 1500, 11)), 0u);
+  EXPECT_EQ(count_differences("bsp", mesh, adversarial_rays(mesh, 500, 12), {{"max_leaf", "0"}}), 0u);
+}
+
 TEST(Termination, RejectsBadTerminationParameters) {
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(random_soup(10, 1)));
-  for (const char* name : kBounded)
+  for (const char* name : {"octree", "kdtree-median", "bsp"})
     EXPECT_THROW(make_accelerator(name, prims, testing::make_params({{"bad_refines", "-1"}})), ParamError);
   for (const char* name : kBudgeted)
     EXPECT_THROW(make_accelerator(name, prims, testing::make_params({{"ref_budget", "0.5"}})), ParamError);

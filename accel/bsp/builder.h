@@ -1,10 +1,13 @@
 // The BSP build with arbitrary split planes (Ize, Wald and Parker 2008, "Ray tracing with the BSP tree";
 // Kammaje and Mora 2007): candidate planes (candidates.h) priced by the SAH over the node's convex cell
 // (cell.h), and a conservative partition (a primitive within the insertion margin of the plane goes to both
-// sides). Large nodes build their two subtrees in parallel, each into its own buffer, appended in a fixed
-// order (the same tree for any thread count). The reference budget (build_with_budget, refine_rules.h) is
-// the safety net of the references: at most ref_budget per primitive, the tree unchanged on any input whose
-// tree stays under it.
+// sides). Each triangle's part in the cell is kept from the parent and clipped by the one new plane per
+// level. Termination on any input (issue 11): the SAH; shaves (one child keeps every primitive) as pbrt-v3's
+// bad refines, limited per path; kdtree-sah's max_leaf split of a large node the SAH would keep; the
+// reference budget (build_with_budget, refine_rules.h) as the safety net of the references, at most
+// ref_budget per primitive, the tree unchanged on any input whose tree stays under it. Large nodes build
+// their two subtrees in parallel, each into its own buffer, appended in a fixed order (the same tree for
+// any thread count).
 #pragma once
 
 #include <tbb/parallel_invoke.h>
@@ -35,7 +38,7 @@ class BspBuilder {
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = BspBuffer{};
-      build_node(std::vector<uint32_t>(ids), ConvexCell::from_box(box), {}, Depth{0, 0, budget}, out);
+      build_node(gather_root(ids, box), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;
@@ -48,14 +51,20 @@ class BspBuilder {
     BspPlane plane;
     float cost = kInf;
   };
-  /// The node's primitives that reach its cell's (grown) bounding box, each with the support points of
-  /// its part inside that box: classifying the clipped part, not the whole primitive, keeps long
+  /// The node's primitives that reach its cell, each with the support points of its part inside the cell's
+  /// (grown) bounding box and half-spaces: classifying the clipped part, not the whole primitive, keeps long
   /// primitives from being duplicated into every cell their supporting line or plane crosses.
   struct NodePrims {
     std::vector<uint32_t> ids;
     std::vector<uint32_t> start{0};
     std::vector<vec3> pts;
     size_t size() const { return ids.size(); }
+    /// Appends primitive id with its k support points.
+    void add(uint32_t id, const vec3* p, int k) {
+      ids.push_back(id);
+      pts.insert(pts.end(), p, p + k);
+      start.push_back(uint32_t(pts.size()));
+    }
   };
 
   /// A half-space dot(n, x) <= offset bounding the cell (already grown by the margin).
@@ -64,92 +73,130 @@ class BspBuilder {
     float offset;
   };
 
-  NodePrims gather(const std::vector<uint32_t>& ids, const ConvexCell& cell,
-                   const std::vector<HalfSpace>& path) const {
-    AABB box = cell.bounds();
-    box = {box.lo - vec3(margin_), box.hi + vec3(margin_)};
+  /// Box b grown by the insertion margin.
+  AABB grown(const AABB& b) const { return {b.lo - vec3(margin_), b.hi + vec3(margin_)}; }
+
+  /// The root's primitives, clipped to the root box.
+  NodePrims gather_root(const std::vector<uint32_t>& ids, const AABB& box) const {
+    const AABB g = grown(box);
     NodePrims np;
     vec3 buf[kMaxSupportPoints];
-    for (uint32_t id : ids) {
-      int k = support_points(prims_, id, box, buf);
-      if constexpr (std::is_same_v<P, TrianglePrims>) k = clip_to_path(buf, k, path);
-      if (k == 0) continue;
-      np.ids.push_back(id);
-      np.pts.insert(np.pts.end(), buf, buf + k);
-      np.start.push_back(uint32_t(np.pts.size()));
-    }
+    for (uint32_t id : ids)
+      if (const int k = support_points(prims_, id, g, buf); k > 0) np.add(id, buf, k);
     return np;
   }
 
-  /// Clips a triangle's polygon by the oblique half-spaces of the path (the box took care of the axes).
-  /// Stops clipping (keeping a superset) before the polygon could outgrow its fixed capacity.
-  static int clip_to_path(vec3* pts, int k, const std::vector<HalfSpace>& path) {
-    if (k == 0 || path.empty()) return k;
-    ClipPolygon poly;
-    std::copy(pts, pts + k, poly.v.begin());
-    poly.n = k;
-    for (const HalfSpace& h : path) {
-      if (poly.n == 0 || poly.n + 2 >= int(poly.v.size())) break;
-      clip_polygon(poly, h.n, h.offset);
+  /// The primitives of the child on side `bit` (1 below, 2 above) of plane, whose cell is `cell`. A
+  /// triangle's part is its part in the parent clipped by the one new half-space (grown by the margin) and
+  /// the child's grown bounding box: one plane per level instead of the triangle clipped again by every
+  /// plane on its path. Other primitive sets take their support points in the child's box again.
+  NodePrims child_prims(const NodePrims& np, const std::vector<uint8_t>& sides, int bit,
+                        const BspPlane& plane, const ConvexCell& cell) const {
+    const AABB box = grown(cell.bounds());
+    const HalfSpace cut =
+        bit == 1 ? HalfSpace{plane.n, plane.d + margin_} : HalfSpace{-plane.n, margin_ - plane.d};
+    const bool oblique = is_oblique(plane);
+    NodePrims out;
+    vec3 buf[kMaxSupportPoints];
+    for (size_t k = 0; k < np.size(); ++k) {
+      if (!(sides[k] & bit)) continue;
+      int m = 0;
+      if constexpr (std::is_same_v<P, TrianglePrims>) {
+        m = clip_part(np, k, oblique ? &cut : nullptr, box, buf);
+      } else {
+        m = support_points(prims_, np.ids[k], box, buf);
+      }
+      if (m > 0) out.add(np.ids[k], buf, m);
     }
-    std::copy(poly.v.begin(), poly.v.begin() + poly.n, pts);
+    return out;
+  }
+
+  /// Primitive k's part clipped by half-space cut (when given) and box, into out. Leaves a clip out (keeping
+  /// a superset) when the polygon could outgrow its fixed capacity.
+  static int clip_part(const NodePrims& np, size_t k, const HalfSpace* cut, const AABB& box, vec3* out) {
+    ClipPolygon poly;
+    const int capacity = int(poly.v.size());
+    poly.n = std::min(int(np.start[k + 1] - np.start[k]), kMaxSupportPoints);
+    for (int j = 0; j < poly.n; ++j) poly.v[size_t(j)] = np.pts[np.start[k] + size_t(j)];
+    if (cut && poly.n + 2 < capacity) clip_polygon(poly, cut->n, cut->offset);
+    AABB b;
+    for (int j = 0; j < poly.n; ++j) b.extend(poly.v[j]);
+    if (poly.n > 0 && !b.overlaps(box)) return 0;
+    if (poly.n > 0 && !(box.contains(b.lo) && box.contains(b.hi)) && poly.n + 7 < capacity)
+      clip_polygon_to_box(poly, box);
+    for (int j = 0; j < poly.n; ++j) out[j] = poly.v[size_t(j)];
     return poly.n;
   }
 
   /// Depth of a node: all levels, and the splits with primitives on both sides. A split with an empty side
   /// (cutting off empty space, often a corner of the cell by an oblique plane) never puts an entry on the
   /// traversal stack, so only the other splits count against max_depth; the levels have their own bound.
-  /// With the node's reference budget.
+  /// With the shaves on the path (bad refines) and the node's reference budget.
   struct Depth {
-    int levels = 0, splits = 0;
+    int levels = 0, splits = 0, shaves = 0;
     RefBudget budget;
   };
   static constexpr int kEmptyCutLevels = 32;
 
-  void build_node(std::vector<uint32_t>&& ids, const ConvexCell& cell, const std::vector<HalfSpace>& path,
-                  Depth depth, BspBuffer& out) const {
-    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
-    NodePrims np = gather(ids, cell, path);
-    std::vector<uint32_t>().swap(ids);
+  /// The node's plane, or a leaf: the SAH's cheapest plane when it beats the leaf; else, for a node of more
+  /// than max_leaf primitives, the cheapest plane that leaves fewer on each side (kdtree-sah's rule).
+  struct Decision {
+    BspPlane plane;
+    bool split = false, forced = false;
+  };
+  Decision decide(const NodePrims& np, const ConvexCell& cell, const Depth& depth) const {
     const size_t n = np.size();
-    Choice best;
-    if (n > 1 && depth.splits < depth_limit_ && depth.levels < depth_limit_ + kEmptyCutLevels)
-      best = find_plane(np, cell);
-    std::vector<uint32_t> left, right;
-    if (best.cost < config_.costs.leaf(n)) partition(np, best.plane, left, right);
-    if ((left.empty() && right.empty()) || (left.size() == n && right.size() == n) ||
-        !depth.budget.allows(left.size() + right.size())) {
-      if (ledger_) ledger_->add_leaf(n);
-      out.nodes.push_back(out.make_leaf(np.ids));
-      return;
+    if (n <= 1 || depth.splits >= depth_limit_ || depth.levels >= depth_limit_ + kEmptyCutLevels) return {};
+    const bool shave_ok = config_.bad_refines == 0 || depth.shaves + 1 < config_.bad_refines;
+    const Choices c = find_plane(np, cell, shave_ok);
+    if (c.best.cost < config_.costs.leaf(n)) return {c.best.plane, true, false};
+    if (config_.max_leaf > 0 && n > config_.max_leaf && c.progress.cost < kInf)
+      return {c.progress.plane, true, true};
+    return {};
+  }
+
+  /// Appends a leaf of the node's primitives.
+  void make_leaf(const NodePrims& np, BspBuffer& out) const {
+    if (ledger_) ledger_->add_leaf(np.size());
+    out.nodes.push_back(out.make_leaf(np.ids));
+  }
+
+  void build_node(NodePrims&& np, const ConvexCell& cell, Depth depth, BspBuffer& out) const {
+    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
+    const size_t n = np.size();
+    const Decision d = decide(np, cell, depth);
+    std::vector<uint8_t> sides;
+    size_t nl = 0, nr = 0;
+    if (d.split) classify(np, d.plane, sides, nl, nr);
+    if ((nl == 0 && nr == 0) || (nl == n && nr == n) || (d.forced && std::max(nl, nr) == n) ||
+        !depth.budget.allows(nl + nr)) {
+      return make_leaf(np, out);
     }
-    if (ledger_) ledger_->add_children(left.size() + right.size());
+    if (ledger_) ledger_->add_children(nl + nr);
+    const ConvexCell lcell = cell.part(d.plane, true), rcell = cell.part(d.plane, false);
+    NodePrims left = child_prims(np, sides, 1, d.plane, lcell);
+    NodePrims right = child_prims(np, sides, 2, d.plane, rcell);
     np = NodePrims{};
-    const ConvexCell lcell = cell.part(best.plane, true), rcell = cell.part(best.plane, false);
-    std::vector<HalfSpace> lpath = path, rpath = path;
-    if (is_oblique(best.plane)) {
-      lpath.push_back({best.plane.n, best.plane.d + margin_});
-      rpath.push_back({-best.plane.n, -best.plane.d + margin_});
-    }
-    const int levels = depth.levels + 1, splits = depth.splits + int(!left.empty() && !right.empty());
-    const size_t all = left.size() + right.size();
-    const Depth lnext{levels, splits, depth.budget.share(left.size(), all)};
-    const Depth rnext{levels, splits, depth.budget.share(right.size(), all)};
+    const bool shave = is_shave(nl, nr, n);
+    const int levels = depth.levels + 1, splits = depth.splits + int(nl > 0 && nr > 0);
+    const int shaves = depth.shaves + int(shave);
+    const Depth lnext{levels, splits, shaves, depth.budget.share(nl, nl + nr)};
+    const Depth rnext{levels, splits, shaves, depth.budget.share(nr, nl + nr)};
     const size_t self = out.nodes.size();
     const uint32_t plane = uint32_t(out.payload.size());
-    out.payload.push_back(best.plane);
+    out.payload.push_back(d.plane);
     out.nodes.push_back(BspNode::leaf(0, 0));
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lpath, lnext, lb); },
-                           [&] { build_node(std::move(right), rcell, rpath, rnext, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lnext, lb); },
+                           [&] { build_node(std::move(right), rcell, rnext, rb); });
       out.append(lb);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lcell, lpath, lnext, out);
+      build_node(std::move(left), lcell, lnext, out);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rcell, rpath, rnext, out);
+      build_node(std::move(right), rcell, rnext, out);
     }
   }
 
@@ -177,13 +224,40 @@ class BspBuilder {
     return config_.costs.split(cell.area, al, nl, ar, nr);
   }
 
-  Choice find_plane(const NodePrims& np, const ConvexCell& cell) const {
-    Choice best;
+  /// The cheapest plane, and the cheapest one that leaves fewer than the node's n primitives on each side.
+  struct Choices {
+    Choice best, progress;
+  };
+
+  /// A shave: a plane that leaves every primitive of the node on one side and some on the other too, so the
+  /// larger child does all the node's work and the smaller one only copies. On large overlapping triangles
+  /// the SAH prices such corner cuts of the cell just below the leaf again and again (each cell shaved a
+  /// little smaller keeps all its triangles), which grows the references without bound; they are pbrt-v3's
+  /// bad refines here (Pharr, Jakob and Humphreys 2016, 4.4.2: a refinement that does not reduce the work),
+  /// and a node whose path already holds bad_refines - 1 of them considers none.
+  static bool is_shave(size_t nl, size_t nr, size_t n) {
+    return nl > 0 && nr > 0 && double(std::max(nl, nr)) > kShaveShare * double(n);
+  }
+  /// A split whose larger child keeps more than this share of the node's primitives is a shave.
+  static constexpr double kShaveShare = 0.9;
+
+  /// Keeps plane at cost c in the choices (nl and nr primitives below and above, of n).
+  static void keep(Choices& ch, const BspPlane& plane, float c, size_t nl, size_t nr, size_t n,
+                   bool shave_ok) {
+    if (!shave_ok && is_shave(nl, nr, n)) return;
+    if (c < ch.best.cost) ch.best = {plane, c};
+    if (nl < n && nr < n && c < ch.progress.cost) ch.progress = {plane, c};
+  }
+
+  Choices find_plane(const NodePrims& np, const ConvexCell& cell, bool shave_ok) const {
+    Choices ch;
     const CellSurface surface(cell);
     const float area = surface.area();
-    if (!(area > 0.0f)) return best;
+    if (!(area > 0.0f)) return ch;
     const CellArea cell_area{area, 1.0f / area};
-    for (const vec3& dir : bsp_directions()) binned_planes(np, surface, cell_area, dir, best);
+    PlaneScratch scratch;
+    for (const vec3& dir : bsp_directions())
+      binned_planes(np, surface, cell_area, dir, shave_ok, scratch, ch);
     const size_t k = std::min<size_t>(np.size(), size_t(config_.autopartition));
     for (size_t j = 0; j < k; ++j) {
       BspPlane own;
@@ -193,20 +267,28 @@ class BspBuilder {
       const float d[3] = {own.d, own.d - 2.0f * margin_, own.d + 2.0f * margin_};
       float al[3], ar[3];
       surface.areas(own.n, d, al, ar);
-      for (int m = 0; m < 3; ++m) {
-        const BspPlane plane{own.n, d[m]};
-        size_t nl = 0, nr = 0;
-        for (size_t i = 0; i < np.size(); ++i) {
-          const int s = side(np, i, plane);
-          nl += s & 1;
-          nr += s >> 1;
+      size_t nl[3] = {0, 0, 0}, nr[3] = {0, 0, 0};
+      for (size_t i = 0; i < np.size(); ++i) {
+        float lo, hi;  // one range for the three planes, shifted
+        range(np, i, own.n, own.d, lo, hi);
+        for (int m = 0; m < 3; ++m) {
+          const int s = side_bits(lo - (d[m] - own.d), hi - (d[m] - own.d));
+          nl[m] += s & 1;
+          nr[m] += s >> 1;
         }
-        const float c = cost(cell_area, al[m], ar[m], nl, nr);
-        if (c < best.cost) best = {plane, c};
       }
+      for (int m = 0; m < 3; ++m)
+        keep(ch, BspPlane{own.n, d[m]}, cost(cell_area, al[m], ar[m], nl[m], nr[m]), nl[m], nr[m], np.size(),
+             shave_ok);
     }
-    return best;
+    return ch;
   }
+
+  /// The buffers of binned_planes, kept over the 13 directions of a node.
+  struct PlaneScratch {
+    std::vector<float> lo, hi, d, al, ar;
+    std::vector<uint32_t> nl, nr;
+  };
 
   /// Candidate planes of direction dir. A node of at most `bins` primitives tries the planes at the ends of
   /// each primitive's extent (the primitive is classified on one side only), like the events of a k-d sweep;
@@ -215,9 +297,15 @@ class BspBuilder {
   /// least 1/bins of the cell's extent, or each node would shave off another sliver (its primitives clipped a
   /// little tighter) down to the depth limit.
   void binned_planes(const NodePrims& np, const CellSurface& surface, const CellArea& cell_area,
-                     const vec3& dir, Choice& best) const {
+                     const vec3& dir, bool shave_ok, PlaneScratch& s, Choices& ch) const {
     const size_t n = np.size();
-    std::vector<float> lo(n), hi(n);
+    std::vector<float>&lo = s.lo, &hi = s.hi, &d = s.d, &al = s.al, &ar = s.ar;
+    std::vector<uint32_t>&nl = s.nl, &nr = s.nr;
+    lo.resize(n);
+    hi.resize(n);
+    d.clear();
+    nl.clear();
+    nr.clear();
     float range_lo = kInf, range_hi = -kInf;
     for (size_t i = 0; i < n; ++i) {
       range(np, i, dir, 0.0f, lo[i], hi[i]);
@@ -225,8 +313,6 @@ class BspBuilder {
       range_hi = std::max(range_hi, hi[i]);
     }
     if (!(range_hi > range_lo)) return;
-    std::vector<float> d;
-    std::vector<uint32_t> nl, nr;
     if (n <= size_t(config_.bins)) {
       exact_candidates(lo, hi, d, nl, nr);
     } else {
@@ -235,13 +321,13 @@ class BspBuilder {
     float cell_lo, cell_hi;
     surface.extent(dir, cell_lo, cell_hi);
     const float min_gap = (cell_hi - cell_lo) / float(config_.bins);
-    std::vector<float> al(d.size()), ar(d.size());
+    al.resize(d.size());
+    ar.resize(d.size());
     surface.areas(dir, d, al.data(), ar.data());
     for (size_t j = 0; j < d.size(); ++j) {
       if (nl[j] == 0 && !(d[j] - cell_lo >= min_gap)) continue;
       if (nr[j] == 0 && !(cell_hi - d[j] >= min_gap)) continue;
-      const float c = cost(cell_area, al[j], ar[j], nl[j], nr[j]);
-      if (c < best.cost) best = {BspPlane{dir, d[j]}, c};
+      keep(ch, BspPlane{dir, d[j]}, cost(cell_area, al[j], ar[j], nl[j], nr[j]), nl[j], nr[j], n, shave_ok);
     }
   }
 
@@ -307,12 +393,14 @@ class BspBuilder {
     return side_bits(lo, hi);
   }
 
-  void partition(const NodePrims& np, const BspPlane& plane, std::vector<uint32_t>& left,
-                 std::vector<uint32_t>& right) const {
+  /// Side bits of every primitive of the node against plane (side_bits), and the counts below and above.
+  void classify(const NodePrims& np, const BspPlane& plane, std::vector<uint8_t>& sides, size_t& nl,
+                size_t& nr) const {
+    sides.resize(np.size());
     for (size_t k = 0; k < np.size(); ++k) {
-      const int s = side(np, k, plane);
-      if (s & 1) left.push_back(np.ids[k]);
-      if (s & 2) right.push_back(np.ids[k]);
+      sides[k] = uint8_t(side(np, k, plane));
+      nl += sides[k] & 1;
+      nr += sides[k] >> 1;
     }
   }
 

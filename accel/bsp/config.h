@@ -1,6 +1,8 @@
 // The BSP tree's configuration: each field's initializer is its default, read once from the parameters.
 #pragma once
 
+#include <cstddef>
+
 #include "accel/common/leaf_refs.h"
 #include "accel/common/sah.h"
 #include "accel/core/params.h"
@@ -19,6 +21,12 @@ struct BspConfig {
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   double ref_budget =
       32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
+  /// A node whose path holds bad_refines - 1 shaves considers no more (BspBuilder::is_shave; pbrt-v3's
+  /// count; 0: shaves always allowed).
+  int bad_refines = 3;
+  /// A node the cost model makes a leaf splits at its cheapest plane anyway while it holds more than this
+  /// many primitives and each child fewer (as kdtree-sah; 0: never).
+  size_t max_leaf = 64;
 
   /// Reads every field from params.
   static BspConfig read(Params& params) {
@@ -31,6 +39,8 @@ struct BspConfig {
     params.read("max_depth", c.max_depth, 0, 100);
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
     params.read("ref_budget", c.ref_budget, 1.0, 1e6);
+    params.read("bad_refines", c.bad_refines, 0, 1000);
+    params.read("max_leaf", c.max_leaf, 0, size_t(1) << 30);
     return c;
   }
 };
