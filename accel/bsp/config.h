@@ -21,8 +21,8 @@ struct BspConfig {
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   double ref_budget =
       32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
-  /// A node whose path holds bad_refines - 1 shaves considers no more (BspBuilder::is_shave; pbrt-v3's
-  /// count; 0: shaves always allowed).
+  /// A node of more than 64 primitives whose path holds bad_refines - 1 shaves considers no more
+  /// (BspBuilder::is_shave; pbrt-v3's count; 0: shaves always allowed).
   int bad_refines = 3;
   /// A node the cost model makes a leaf splits at its cheapest plane anyway while it holds more than this
   /// many primitives and each child fewer (as kdtree-sah; 0: never).
