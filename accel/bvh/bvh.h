@@ -21,6 +21,7 @@
 #include "accel/bvh/leaf_blocks.h"
 #include "accel/bvh/node.h"
 #include "accel/bvh/node8.h"
+#include "accel/bvh/sbvh.h"
 #include "accel/bvh/tree_visitors.h"
 #include "accel/bvh/walk2.h"
 #include "accel/bvh/walk8.h"
@@ -36,9 +37,10 @@ namespace ab {
 template <class B>
 struct BvhRefit;
 
-/// A BVH over primitive set P built by the builder of its Config C (BvhMedianConfig, BvhSahConfig or
-/// BvhSweepConfig). For triangles the vertices are copied into leaf order for locality (blocks of four for
-/// width 8); hits still carry the original ids.
+/// A BVH over primitive set P built by the builder of its Config C (BvhMedianConfig, BvhSahConfig,
+/// BvhSweepConfig or BvhSbvhConfig, whose spatial splits may reference a primitive from several leaves). For
+/// triangles the vertices are copied into leaf order for locality (blocks of four for width 8); hits still
+/// carry the original ids.
 template <class P, class C>
 class Bvh final : public AcceleratorBase<Bvh<P, C>> {
  public:
@@ -164,6 +166,8 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
  private:
   friend struct BvhRefit<Bvh>;
   static constexpr bool kCopiesTriangles = std::is_same_v<P, TrianglePrims>;
+  /// The spatial-split builder clips primitives, so it gets their clipped bounds too (sbvh.h).
+  static constexpr bool kSpatialSplits = std::is_same_v<C, BvhSbvhConfig>;
 
   /// What a wide leaf is tested with: the ray broadcast to four lanes for triangle blocks, else the ray.
   using LeafRay = std::conditional_t<kCopiesTriangles, Ray4, Ray>;
@@ -179,14 +183,21 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
         centroids[i] = prims_->centroid(i);
       }
     });
-    return build_bvh(config_, boxes, centroids);
+    if constexpr (kSpatialSplits)
+      return build_bvh(config_, boxes,
+                       [&](uint32_t i, const AABB& box) { return prims_->clipped_bounds(i, box); });
+    else
+      return build_bvh(config_, boxes, centroids);
   }
 
   /// Replaces the binary tree by its 8-wide collapse, keeping the binary tree's figures for the report.
   void collapse() {
     binary_ = BuildStats{};
     if (!nodes_.empty()) walk_tree_stats(BvhTreeVisitor{nodes_}, binary_);
-    wide_ = collapse_to_bvh8(nodes_);
+    if constexpr (requires { config_.collapse; })
+      wide_ = collapse_to_bvh8(nodes_, config_.collapse);
+    else
+      wide_ = collapse_to_bvh8(nodes_);
     BvhNodeArray().swap(nodes_);
   }
 
@@ -289,6 +300,9 @@ using BvhSah = Bvh<P, BvhSahConfig>;
 /// Full-sweep SAH BVH (registered as bvh-sweep).
 template <class P>
 using BvhSweep = Bvh<P, BvhSweepConfig>;
+/// Binned SAH BVH with spatial splits (registered as bvh-sbvh).
+template <class P>
+using BvhSbvh = Bvh<P, BvhSbvhConfig>;
 
 }  // namespace ab
 

@@ -21,25 +21,13 @@ struct Kids {
   }
 };
 
-/// Recursive collapse of the binary tree into the wide array.
-class Bvh8Collapser {
+/// The greedy choice of a wide node's children (Wald, Benthin and Boulos 2008, section 3): open the interior
+/// child of largest area until there are eight.
+class GreedyChildren {
  public:
-  Bvh8Collapser(const BvhNodeArray& binary, Bvh8NodeArray& wide) : binary_(binary), wide_(wide) {}
+  explicit GreedyChildren(const BvhNodeArray& binary) : binary_(binary) {}
 
-  /// Collapses the whole tree (the binary root becomes the wide root's children, or its only leaf).
-  void run() {
-    wide_.emplace_back();
-    if (binary_[0].is_leaf()) {
-      Kids root;
-      root.insert(0, 0);
-      fill(0, root);
-    } else {
-      collapse(0, 0);
-    }
-  }
-
- private:
-  /// Children of binary interior node b: open the interior child of largest area until there are 8.
+  /// Children of binary interior node b.
   Kids children_of(uint32_t b) const {
     Kids kids;
     kids.insert(0, binary_[b].offset);
@@ -59,6 +47,93 @@ class Bvh8Collapser {
     return kids;
   }
 
+ private:
+  const BvhNodeArray& binary_;
+};
+
+// The SAH-optimal choice by dynamic programming over the binary tree (Ylitie, Karras and Laine 2017,
+// "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", section 3.1), with the binary
+// tree's leaves kept as they are, so the leaves' costs are the same whatever the choice and the SAH cost to
+// minimize is the traversal cost times the summed area of the wide nodes: F(n, i) is the least summed area
+// of the wide nodes made from the binary subtree n as a forest of at most i lanes. For a leaf F(n, i) = 0;
+// for an interior node with children l, r, D(n, j) = min over 0 < k < j of F(l, k) + F(r, j - k),
+// F(n, 1) = A(n) + D(n, 8) (n becomes a wide node) and F(n, i) = min(F(n, 1), D(n, i)). Children come after
+// their parents in the binary array, so one reverse pass evaluates it; the choices are kept and replayed from
+// the root.
+class OptimalChildren {
+ public:
+  explicit OptimalChildren(const BvhNodeArray& binary)
+      : binary_(binary), cost_(binary.size() * kW), split_(binary.size() * kW), open_(binary.size()) {
+    for (size_t n = binary.size(); n-- > 0;)
+      if (n != 1 && !binary[n].is_leaf()) evaluate(uint32_t(n));
+  }
+
+  /// Children of binary interior node b: its subtree as the cheapest forest of at most eight lanes.
+  Kids children_of(uint32_t b) const {
+    Kids kids;
+    forest(binary_[b].offset, open_[b], kids);
+    forest(binary_[b].offset + 1, kW - open_[b], kids);
+    return kids;
+  }
+
+ private:
+  static constexpr int kW = Bvh8Node::kWidth;
+
+  void evaluate(uint32_t n) {
+    const uint32_t l = binary_[n].offset, r = l + 1;
+    float best[kW + 1];
+    uint8_t best_k[kW + 1];
+    for (int j = 2; j <= kW; ++j) {
+      best[j] = kInf;
+      for (int k = 1; k < j; ++k) {
+        const float c = cost_[size_t(l) * kW + k - 1] + cost_[size_t(r) * kW + j - k - 1];
+        if (c < best[j]) best[j] = c, best_k[j] = uint8_t(k);
+      }
+    }
+    const float as_node = binary_[n].box().area() + best[kW];
+    open_[n] = best_k[kW];
+    cost_[size_t(n) * kW] = as_node;
+    split_[size_t(n) * kW] = 0;
+    for (int i = 2; i <= kW; ++i) {
+      const bool open = best[i] < as_node;
+      cost_[size_t(n) * kW + i - 1] = open ? best[i] : as_node;
+      split_[size_t(n) * kW + i - 1] = open ? best_k[i] : 0;
+    }
+  }
+  /// Appends the forest chosen for F(n, i).
+  void forest(uint32_t n, int i, Kids& kids) const {
+    const int k = binary_[n].is_leaf() ? 0 : split_[size_t(n) * kW + i - 1];
+    if (k == 0) return kids.insert(kids.size(), n);
+    forest(binary_[n].offset, k, kids);
+    forest(binary_[n].offset + 1, i - k, kids);
+  }
+
+  const BvhNodeArray& binary_;
+  std::vector<float> cost_;     ///< F(n, i) at n * 8 + i - 1
+  std::vector<uint8_t> split_;  ///< 0: n is one lane; else the lanes of the left child in F(n, i)
+  std::vector<uint8_t> open_;   ///< the left child's lanes when n becomes a wide node
+};
+
+/// Recursive collapse of the binary tree into the wide array, with the children chosen by Children.
+template <class Children>
+class Bvh8Collapser {
+ public:
+  Bvh8Collapser(const BvhNodeArray& binary, const Children& children, Bvh8NodeArray& wide)
+      : binary_(binary), children_(children), wide_(wide) {}
+
+  /// Collapses the whole tree (the binary root becomes the wide root's children, or its only leaf).
+  void run() {
+    wide_.emplace_back();
+    if (binary_[0].is_leaf()) {
+      Kids root;
+      root.insert(0, 0);
+      fill(0, root);
+    } else {
+      collapse(0, 0);
+    }
+  }
+
+ private:
   /// Writes the boxes and references of `kids` into wide node w (unused lanes stay empty).
   void fill(uint32_t w, const Kids& kids) {
     Bvh8Node& node = wide_[w];
@@ -76,7 +151,7 @@ class Bvh8Collapser {
 
   /// Fills wide node w from binary interior node b; interior children get consecutive new wide nodes.
   void collapse(uint32_t b, uint32_t w) {
-    const Kids kids = children_of(b);
+    const Kids kids = children_.children_of(b);
     fill(w, kids);
     for (size_t k = 0; k < kids.size(); ++k) {
       if (binary_[kids[k]].is_leaf()) continue;
@@ -88,18 +163,26 @@ class Bvh8Collapser {
   }
 
   const BvhNodeArray& binary_;
+  const Children& children_;
   Bvh8NodeArray& wide_;
 };
 
 }  // namespace
 
 // Collapse after Wald, Benthin and Boulos 2008 (section 3: "pull up" the children of the largest-area
-// interior child until the node is full), applied top down to the binary SAH tree.
-Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary) {
+// interior child until the node is full), applied top down to the binary SAH tree; or with the children
+// chosen by Ylitie, Karras and Laine 2017's dynamic programming (OptimalChildren above).
+Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method) {
   Bvh8NodeArray wide;
   if (binary.empty()) return wide;
   wide.reserve(binary.size() / 4 + 1);
-  Bvh8Collapser(binary, wide).run();
+  if (method == BvhCollapse::optimal) {
+    const OptimalChildren children(binary);
+    Bvh8Collapser(binary, children, wide).run();
+  } else {
+    const GreedyChildren children(binary);
+    Bvh8Collapser(binary, children, wide).run();
+  }
   return wide;
 }
 

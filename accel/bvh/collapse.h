@@ -1,15 +1,18 @@
 // The collapse of the binary BVH into the 8-wide one (collapse.cpp).
 #pragma once
 
+#include "accel/bvh/config.h"
 #include "accel/bvh/node.h"
 #include "accel/bvh/node8.h"
 
 namespace ab {
 
-/// Collapses a binary BVH (build_bvh's layout, not empty) into an 8-wide one: each wide node takes a binary
-/// node's two children and keeps opening the interior child of largest surface area until it has eight
-/// children or only leaves. Leaves keep their primitive ranges. Node 0 is the root; when the binary root is
-/// a leaf, the wide root holds it as its only lane.
-Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary);
+/// Collapses a binary BVH (build_bvh's layout, not empty) into an 8-wide one. Greedy: each wide node takes a
+/// binary node's two children and keeps opening the interior child of largest surface area until it has
+/// eight children or only leaves. Optimal: the children minimize the SAH cost of the wide tree (with the
+/// leaves fixed, the summed area of the wide nodes) over every way of opening the binary tree (dynamic
+/// programming). Leaves keep their primitive ranges. Node 0 is the root; when the binary root is a leaf, the
+/// wide root holds it as its only lane.
+Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method = BvhCollapse::greedy);
 
 }  // namespace ab

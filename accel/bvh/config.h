@@ -30,6 +30,15 @@ inline void read_bvh_width(Params& params, int& width) {
     throw ParamError("parameter 'width': " + std::to_string(width) + " is not 2 or 8");
 }
 
+/// How the binary tree is collapsed into the 8-wide one (collapse.h): greedy (Wald, Benthin and Boulos 2008)
+/// or SAH-optimal (Ylitie, Karras and Laine 2017).
+enum class BvhCollapse { greedy, optimal };
+
+/// Reads the collapse method in place (parameter collapse: greedy or optimal).
+inline void read_bvh_collapse(Params& params, BvhCollapse& collapse) {
+  params.read("collapse", collapse, {{"greedy", BvhCollapse::greedy}, {"optimal", BvhCollapse::optimal}});
+}
+
 /// bvh-median: the object median of the centroids on the longest axis.
 struct BvhMedianConfig : BvhTreeConfig {
   int leaf_size = 4;  ///< a node of at most this many primitives becomes a leaf
@@ -61,8 +70,9 @@ struct BvhSahTreeConfig : BvhTreeConfig {
 
 /// bvh-sah: binned SAH (Wald 2007), 8-wide by default.
 struct BvhSahConfig : BvhSahTreeConfig {
-  int bins = 32;  ///< bins per axis
-  int width = 8;  ///< node width, 2 or 8
+  int bins = 32;                               ///< bins per axis
+  int width = 8;                               ///< node width, 2 or 8
+  BvhCollapse collapse = BvhCollapse::greedy;  ///< how width 8 is made from the binary tree
 
   /// Reads every field.
   static BvhSahConfig read(Params& params) {
@@ -70,6 +80,7 @@ struct BvhSahConfig : BvhSahTreeConfig {
     c.read_sah_tree(params);
     params.read("bins", c.bins, 2, 256);
     read_bvh_width(params, c.width);
+    read_bvh_collapse(params, c.collapse);
     return c;
   }
 };

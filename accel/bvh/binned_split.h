@@ -1,0 +1,261 @@
+// The binned SAH split search over references (Wald 2007, "On fast construction of SAH-based bounding volume
+// hierarchies"), shared by the binned builder (binned.cpp) and the spatial-split builder's object splits
+// (sbvh.cpp): the reference layout, vector boxes, the bins of a node on three axes and the sweep over them.
+#pragma once
+
+#include <immintrin.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "accel/bvh/sah_split.h"
+#include "accel/common/binning.h"
+#include "accel/common/sah.h"
+#include "accel/core/aabb.h"
+
+namespace ab {
+/// Nodes at least this large bin and bound their primitives with a parallel reduction. The reductions use
+/// only min, max and integer sums, which are exact, so the result does not depend on how TBB splits.
+inline constexpr size_t kParallelReduceThreshold = 1u << 15;
+inline constexpr size_t kGrain = 1u << 12;
+inline constexpr int kMaxBins = 256;
+
+/// A primitive as the binned builder moves it: its box as two 16-byte vectors, the id in the lo vector's
+/// fourth lane and zero in the hi vector's. lo4() blends the id out, so no arithmetic ever sees its bits
+/// (small ids read as float are denormals, which can cost a microcode assist per operation).
+struct alignas(32) BinRef {
+  float lo[3];
+  uint32_t id;
+  float hi[3];
+  float zero;
+
+  __m128 lo4() const { return _mm_blend_ps(_mm_load_ps(lo), _mm_setzero_ps(), 8); }
+  __m128 hi4() const { return _mm_load_ps(hi); }
+  /// The centre of the box, 0.5 * (lo + hi), bit for bit what AABB::center() and the primitive sets'
+  /// centroid() give (fourth lane 0).
+  __m128 center() const { return _mm_mul_ps(_mm_add_ps(lo4(), hi4()), _mm_set1_ps(0.5f)); }
+};
+static_assert(sizeof(BinRef) == 32);
+
+/// A box as two vectors. Not initialized by default (bins are reset explicitly, only as many as used).
+struct alignas(16) Box4 {
+  __m128 lo;
+  __m128 hi;
+
+  /// The empty box (lo = +inf, hi = -inf).
+  static Box4 empty() { return {_mm_set1_ps(kInf), _mm_set1_ps(-kInf)}; }
+  void extend(__m128 l, __m128 h) {
+    lo = _mm_min_ps(lo, l);
+    hi = _mm_max_ps(hi, h);
+  }
+  void extend(const Box4& b) { extend(b.lo, b.hi); }
+  /// The same value as AABB::area() of the same box, 2 (dx dy + dy dz + dz dx) with the same rounding, and
+  /// 0 when empty (the extent is clamped at 0 instead of branching).
+  float area() const {
+    const __m128 d = _mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps());
+    const __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));  // dx dy, dy dz, dz dx
+    const __m128 s = _mm_add_ss(_mm_add_ss(p, _mm_shuffle_ps(p, p, 1)), _mm_shuffle_ps(p, p, 2));
+    return 2.0f * _mm_cvtss_f32(s);
+  }
+  AABB aabb() const {
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+  }
+};
+
+/// The node's box and the box of its primitives' centroids, passed from a parent to its children.
+struct NodeBounds {
+  Box4 box = Box4::empty();
+  Box4 centroids = Box4::empty();
+};
+
+/// The bin of a centre on all three axes at once: int((c - lo) * scale) clamped to [0, bins - 1], the
+/// arithmetic of BinMapping::bin (binning.h) in one vector.
+struct BinIndexer {
+  __m128 lo, scale;
+  __m128i last;
+
+  explicit BinIndexer(const BinMapping& m)
+      : lo(_mm_setr_ps(m.lo[0], m.lo[1], m.lo[2], 0.0f)),
+        scale(_mm_setr_ps(m.scale[0], m.scale[1], m.scale[2], 0.0f)),
+        last(_mm_set1_epi32(m.bins - 1)) {}
+  __m128i bins(__m128 c) const {
+    const __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
+    return _mm_min_epi32(_mm_max_epi32(k, _mm_setzero_si128()), last);
+  }
+};
+
+/// The bins of one node on the three axes (axis a, bin k at a * nb + k), reducible in parallel.
+struct BinSet {
+  int nb;
+  std::array<Box4, 3 * kMaxBins> box;
+  std::array<uint32_t, 3 * kMaxBins> count;
+
+  explicit BinSet(int bins) : nb(bins) {
+    for (int k = 0; k < 3 * nb; ++k) box[k] = Box4::empty(), count[k] = 0;
+  }
+  void add(const BinRef* refs, uint32_t b, uint32_t e, const BinIndexer& ix) {
+    for (uint32_t k = b; k < e; ++k) {
+      const __m128 lo = refs[k].lo4(), hi = refs[k].hi4();
+      alignas(16) int32_t bin[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(refs[k].center()));
+      for (int a = 0; a < 3; ++a) {
+        const int j = a * nb + bin[a];
+        box[j].extend(lo, hi);
+        ++count[j];
+      }
+    }
+  }
+  void merge(const BinSet& o) {
+    for (int k = 0; k < 3 * nb; ++k) box[k].extend(o.box[k]), count[k] += o.count[k];
+  }
+};
+
+/// Areas of three boxes at once (lane a: box a), each bit for bit AABB::area() (same products, same order).
+inline __m128 areas3(const Box4* box) {
+  __m128 x = _mm_max_ps(_mm_sub_ps(box[0].hi, box[0].lo), _mm_setzero_ps());
+  __m128 y = _mm_max_ps(_mm_sub_ps(box[1].hi, box[1].lo), _mm_setzero_ps());
+  __m128 z = _mm_max_ps(_mm_sub_ps(box[2].hi, box[2].lo), _mm_setzero_ps());
+  __m128 w = _mm_setzero_ps();
+  _MM_TRANSPOSE4_PS(x, y, z, w);  // now x, y, z hold the extents along x, y, z of the three boxes
+  const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+  return _mm_mul_ps(_mm_set1_ps(2.0f), s);
+}
+
+/// The cheapest bin boundary over the three axes, one axis per vector lane (Wald 2007): suffix areas right to
+/// left, then prefix areas left to right. Within an axis a boundary is ranked by left_area * left_count +
+/// right_area * right_count (the cost without its constant terms, so no division per boundary); the first
+/// cheapest boundary of each axis is priced with SahCosts::split, and the first cheapest axis wins. Axes
+/// whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
+inline SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_area,
+                                      const SahCosts& costs) {
+  const int n = bins.nb;
+  auto counts = [&](int k) {
+    return _mm_setr_epi32(int(bins.count[k]), int(bins.count[n + k]), int(bins.count[2 * n + k]), 0);
+  };
+  auto extend = [&](Box4* acc, int k) {
+    for (int a = 0; a < 3; ++a) acc[a].extend(bins.box[a * n + k]);
+  };
+  __m128 right_area[kMaxBins];  // only [1, n) is written and read
+  __m128i right_count[kMaxBins];
+  Box4 acc[3] = {Box4::empty(), Box4::empty(), Box4::empty()};
+  __m128i cnt = _mm_setzero_si128();
+  for (int i = n - 1; i > 0; --i) {
+    extend(acc, i);
+    cnt = _mm_add_epi32(cnt, counts(i));
+    right_area[i] = areas3(acc);
+    right_count[i] = cnt;
+  }
+  acc[0] = acc[1] = acc[2] = Box4::empty();
+  cnt = _mm_setzero_si128();
+  __m128 best_w = _mm_set1_ps(kInf), best_la = _mm_setzero_ps(), best_ra = _mm_setzero_ps();
+  __m128i best_i = _mm_setzero_si128(), best_lc = _mm_setzero_si128();
+  for (int i = 1; i < n; ++i) {
+    extend(acc, i - 1);
+    cnt = _mm_add_epi32(cnt, counts(i - 1));
+    const __m128 la = areas3(acc), ra = right_area[i];
+    const __m128 w =
+        _mm_add_ps(_mm_mul_ps(la, _mm_cvtepi32_ps(cnt)), _mm_mul_ps(ra, _mm_cvtepi32_ps(right_count[i])));
+    const __m128i empty_side = _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()),
+                                            _mm_cmpeq_epi32(right_count[i], _mm_setzero_si128()));
+    const __m128 better =
+        _mm_andnot_ps(_mm_castsi128_ps(empty_side), _mm_and_ps(axis_ok, _mm_cmplt_ps(w, best_w)));
+    best_w = _mm_blendv_ps(best_w, w, better);
+    best_la = _mm_blendv_ps(best_la, la, better);
+    best_ra = _mm_blendv_ps(best_ra, ra, better);
+    best_i = _mm_castps_si128(
+        _mm_blendv_ps(_mm_castsi128_ps(best_i), _mm_castsi128_ps(_mm_set1_epi32(i)), better));
+    best_lc = _mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(best_lc), _mm_castsi128_ps(cnt), better));
+  }
+  alignas(16) int32_t bi[4], lc[4], total[4];
+  alignas(16) float bla[4], bra[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(bi), best_i);
+  _mm_store_si128(reinterpret_cast<__m128i*>(lc), best_lc);
+  _mm_store_si128(reinterpret_cast<__m128i*>(total), _mm_add_epi32(cnt, counts(n - 1)));
+  _mm_store_ps(bla, best_la);
+  _mm_store_ps(bra, best_ra);
+  SahSplit best;
+  for (int a = 0; a < 3; ++a) {
+    if (bi[a] == 0) continue;
+    const float c = costs.split(parent_area, bla[a], uint32_t(lc[a]), bra[a], uint32_t(total[a] - lc[a]));
+    if (c < best.cost) best = {a, bi[a], c};
+  }
+  return best;
+}
+
+/// TBB body binning a large range in parallel (the imperative form: a BinSet is copied only when a
+/// subrange is stolen).
+struct ParallelBinning {
+  const BinRef* refs;
+  const BinIndexer& ix;
+  BinSet bins;
+
+  ParallelBinning(const BinRef* r, const BinIndexer& i, int nb) : refs(r), ix(i), bins(nb) {}
+  ParallelBinning(ParallelBinning& o, tbb::split) : refs(o.refs), ix(o.ix), bins(o.bins.nb) {}
+  void operator()(const tbb::blocked_range<uint32_t>& r) { bins.add(refs, r.begin(), r.end(), ix); }
+  void join(const ParallelBinning& o) { bins.merge(o.bins); }
+};
+
+/// The chosen split of a node: SahSplit plus the children's boxes (unions of bins).
+struct BinnedSplit {
+  SahSplit sah;
+  Box4 left = Box4::empty(), right = Box4::empty();
+  uint32_t left_count = 0;
+};
+
+/// The box and the centroid box of refs [b, e): a parallel reduction for large ranges (min and max are
+/// exact, so the result does not depend on how TBB splits).
+inline NodeBounds bounds_of_refs(const BinRef* refs, size_t b, size_t e) {
+  auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      acc.box.extend(refs[k].lo4(), refs[k].hi4());
+      const __m128 c = refs[k].center();
+      acc.centroids.extend(c, c);
+    }
+    return acc;
+  };
+  if (e - b < kParallelReduceThreshold) return body(tbb::blocked_range<size_t>(b, e), NodeBounds{});
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(b, e, kGrain), NodeBounds{}, body,
+                              [](NodeBounds x, const NodeBounds& y) {
+                                x.box.extend(y.box);
+                                x.centroids.extend(y.centroids);
+                                return x;
+                              });
+}
+
+/// The cheapest bin boundary of refs [b, e) over the three axes (binned with `map`, over the node's box
+/// `node_box`), with the children's boxes as unions of bins; large ranges bin in parallel (exact reductions,
+/// so the result does not depend on the thread count).
+inline BinnedSplit find_binned_split(const BinRef* refs, uint32_t b, uint32_t e, const Box4& node_box,
+                                     const BinMapping& map, const SahCosts& costs) {
+  const BinIndexer ix(map);
+  BinnedSplit out;
+  auto evaluate = [&](const BinSet& bins) {
+    const __m128 axis_ok =
+        _mm_cmpgt_ps(_mm_setr_ps(map.scale[0], map.scale[1], map.scale[2], 0.0f), _mm_setzero_ps());
+    out.sah = best_split_three_axes(bins, axis_ok, node_box.area(), costs);
+    if (out.sah.axis < 0) return;
+    const int base = out.sah.axis * bins.nb;
+    for (int k = 0; k < bins.nb; ++k) {
+      (k < out.sah.position ? out.left : out.right).extend(bins.box[base + k]);
+      if (k < out.sah.position) out.left_count += bins.count[base + k];
+    }
+  };
+  if (e - b < kParallelReduceThreshold) {
+    BinSet bins(map.bins);
+    bins.add(refs, b, e, ix);
+    evaluate(bins);
+  } else {
+    ParallelBinning body(refs, ix, map.bins);
+    tbb::parallel_reduce(tbb::blocked_range<uint32_t>(b, e, kGrain), body);
+    evaluate(body.bins);
+  }
+  return out;
+}
+
+}  // namespace ab
