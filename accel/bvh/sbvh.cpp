@@ -71,14 +71,24 @@ struct Clipper {
 
   /// The position of bin boundary k on axis a.
   float plane(int a, int k) const { return map.lo[a] + float(k) / map.scale[a]; }
-  /// The bounds of the part of ref's primitive in ref's box cut to [lo, hi] on axis a.
-  AABB piece(const BinRef& ref, int a, float lo, float hi) const {
+  /// Ref's box cut to [lo, hi] on axis a.
+  AABB slab(const BinRef& ref, int a, float lo, float hi) const {
     AABB child = box_of(ref);
     child.lo[a] = std::clamp(lo, child.lo[a], child.hi[a]);
     child.hi[a] = std::clamp(hi, child.lo[a], child.hi[a]);
-    return clip_into_child(source, ref.id, child, margin);
+    return child;
+  }
+  /// The bounds of the part of ref's primitive in ref's box cut to [lo, hi] on axis a.
+  AABB piece(const BinRef& ref, int a, float lo, float hi) const {
+    return clip_into_child(source, ref.id, slab(ref, a, lo, hi), margin);
   }
 };
+
+/// A reference straddling more bins than this is binned by its box cut to each bin instead of its
+/// primitive's clipped part (only for pricing; a split reference is still clipped), which bounds the
+/// clipping work per reference and node: large triangles spanning the whole node (the hostile generators)
+/// would otherwise cost a clip per bin, axis and level.
+constexpr int kMaxClippedBins = 4;
 
 /// The spatial bins of one node on the three axes (axis a, bin k at a * nb + k): the box of the references'
 /// parts inside each bin and how many references start (entry) and end (exit) in it. Reducible in parallel.
@@ -100,10 +110,11 @@ struct SpatialBins {
     ++entry[a * nb + first];
     ++exit[a * nb + last];
     if (first == last) return box[a * nb + first].extend(ref.lo4(), ref.hi4());
+    const bool clip = last - first < kMaxClippedBins;
     for (int k = first; k <= last; ++k) {
       const float lo = k == first ? ref.lo[a] : cx.plane(a, k);
       const float hi = k == last ? ref.hi[a] : cx.plane(a, k + 1);
-      box[a * nb + k].extend(box4_of(cx.piece(ref, a, lo, hi)));
+      box[a * nb + k].extend(box4_of(clip ? cx.piece(ref, a, lo, hi) : cx.slab(ref, a, lo, hi)));
     }
   }
   void merge(const SpatialBins& o) {
@@ -132,9 +143,10 @@ struct SpatialSplit {
 };
 
 /// Sweeps every bin boundary of every axis of `bins` (suffix boxes and exit counts right to left, then
-/// prefix boxes and entry counts left to right); the first cheapest boundary with both sides non-empty wins.
+/// prefix boxes and entry counts left to right); the first cheapest boundary with both sides non-empty and
+/// at most `room` references on the two sides wins.
 SpatialSplit best_spatial_split(const SpatialBins& bins, const BinMapping& map, float parent_area,
-                                const SahCosts& costs) {
+                                const SahCosts& costs, uint32_t room) {
   const int n = bins.nb;
   SpatialSplit best;
   for (int a = 0; a < 3; ++a) {
@@ -154,7 +166,7 @@ SpatialSplit best_spatial_split(const SpatialBins& bins, const BinMapping& map, 
     for (int i = 1; i < n; ++i) {
       acc.extend(bins.box[a * n + i - 1]);
       count += bins.entry[a * n + i - 1];
-      if (count == 0 || right_count[i] == 0) continue;
+      if (count == 0 || right_count[i] == 0 || uint64_t(count) + right_count[i] > room) continue;
       const float c = costs.split(parent_area, acc.area(), count, right_area[i], right_count[i]);
       if (c < best.sah.cost) best = {{a, i, c}, count, right_count[i]};
     }
@@ -275,8 +287,7 @@ SplitChoice SbvhBuilder::choose_split(RefRange r, const NodeBounds& nb) const {
   const int spatial_bins = std::max(4, int(std::min(uint32_t(config_.spatial_bins), n)));
   c.spatial_map = BinMapping(box, spatial_bins);
   c.spatial = find_spatial_split(r, Clipper{source_, c.spatial_map, c.margin}, nb.box.area());
-  c.use_spatial = c.spatial.sah.axis >= 0 && c.spatial.sah.cost < c.object.sah.cost &&
-                  c.spatial.left_count + c.spatial.right_count <= r.end - r.b;
+  c.use_spatial = c.spatial.sah.axis >= 0 && c.spatial.sah.cost < c.object.sah.cost;
   return c;
 }
 
@@ -285,11 +296,11 @@ SpatialSplit SbvhBuilder::find_spatial_split(RefRange r, const Clipper& cx, floa
   if (r.e - r.b < kParallelReduceThreshold) {
     SpatialBins bins(cx.map.bins);
     bins.add(refs_.get(), r.b, r.e, cx);
-    return best_spatial_split(bins, cx.map, parent_area, config_.costs);
+    return best_spatial_split(bins, cx.map, parent_area, config_.costs, r.end - r.b);
   }
   ParallelSpatialBinning body(refs_.get(), cx);
   tbb::parallel_reduce(tbb::blocked_range<uint32_t>(r.b, r.e, kGrain), body);
-  return best_spatial_split(body.bins, cx.map, parent_area, config_.costs);
+  return best_spatial_split(body.bins, cx.map, parent_area, config_.costs, r.end - r.b);
 }
 
 /// Each reference to the side of its centroid's bin (the binned builder's rule, bit for bit).
