@@ -142,15 +142,6 @@ inline size_t count_differences(const std::string& name, const Mesh& mesh, const
   return diff;
 }
 
-/// Creates and builds accelerator `name` over the mesh with params.
-inline std::unique_ptr<Accelerator> built_accelerator(const std::string& name, const Mesh& mesh,
-                                                      std::map<std::string, std::string> params = {}) {
-  auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
-  auto accel = make_accelerator(name, prims, Params(std::move(params)));
-  accel->build();
-  return accel;
-}
-
 /// A scene of `copies` transformed instances of one base mesh built with `base_name`, returned as the
 /// instance set (for top-level tests).
 inline std::shared_ptr<const InstancePrims> make_instances(const Mesh& mesh, const std::string& base_name,
