@@ -251,7 +251,7 @@ TEST(Suite, DefaultSuiteIsTheShippedFileAndCoversTheBrief) {
 }
 
 TEST(Suite, ShippedSuitesValidate) {
-  for (const char* name : {"quick", "scaling", "default", "million", "hostile"}) {
+  for (const char* name : {"quick", "scaling", "default", "million", "hostile", "motion"}) {
     const Suite s = read_suite(std::string(ACCELBENCH_SOURCE_DIR) + "/suites/" + name + ".json");
     EXPECT_NO_THROW(validate_suite(s)) << name;
   }

@@ -116,7 +116,7 @@ void embree_scene_inputs(const Scene& scene, std::vector<std::shared_ptr<const M
   meshes.clear();
   instances.clear();
   for (const SceneMesh& m : scene.meshes) meshes.push_back(m.mesh);
-  for (const SceneInstance& si : scene.instances) instances.push_back({si.mesh, si.transform.to_world});
+  for (const SceneInstance& si : scene.instances) instances.push_back({si.mesh, si.transform.to_world, {}});
 }
 
 std::unique_ptr<Accelerator> make_scene_accelerator(std::shared_ptr<const Scene> scene,
