@@ -22,18 +22,10 @@ namespace {
 
 using testing::adversarial_mesh;
 using testing::adversarial_rays;
+using testing::built_accelerator;
 
 using testing::count_differences;
 using testing::random_soup;
-
-/// Creates and builds accelerator `name` over the mesh with params.
-std::unique_ptr<Accelerator> built_accelerator(const std::string& name, const Mesh& mesh,
-                                               std::map<std::string, std::string> params = {}) {
-  auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
-  auto accel = make_accelerator(name, prims, Params(std::move(params)));
-  accel->build();
-  return accel;
-}
 
 /// Spatial splits tried at every node (alpha 0) with room for two references per triangle.
 const std::map<std::string, std::string> kForced = {{"alpha", "0"}, {"ref_budget", "2"}};

@@ -188,4 +188,13 @@ namespace ab::testing {
 inline Params make_params(std::map<std::string, std::string> values) {
   return Params(std::move(values));
 }
+
+/// Creates and builds accelerator `name` over the mesh with params.
+inline std::unique_ptr<Accelerator> built_accelerator(const std::string& name, const Mesh& mesh,
+                                                      std::map<std::string, std::string> params = {}) {
+  auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
+  auto accel = make_accelerator(name, prims, Params(std::move(params)));
+  accel->build();
+  return accel;
+}
 }  // namespace ab::testing
