@@ -5,17 +5,17 @@
 #include "tracer/animation.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "accel/core/error.h"
 #include "accel/core/registry.h"
 #include "accel/core/trace.h"
+#include "tests/cli_test_helpers.h"
+#include "tests/scene_test_helpers.h"
 #include "tracer/deform.h"
 #include "tracer/sampling.h"
 #include "tracer/scene.h"
@@ -135,45 +135,39 @@ TEST(Animation, NamedKeyedTransformsComposeWithInlineElements) {
   EXPECT_EQ(half.world_bounds().hi.x, 4.0f);
 }
 
-void expect_error(const std::string& xml, int line, const std::string& words) {
-  try {
-    parse_scene(xml, "bad.xml", ".");
-    ADD_FAILURE() << "no error for: " << xml;
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("bad.xml:" + std::to_string(line) + ": ", 0), 0u) << msg;
-    EXPECT_NE(msg.find(words), std::string::npos) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-  }
-}
-
 TEST(Animation, BadKeyframesAreErrorsNamingTheLine) {
-  expect_error(keyed_scene("<keyframe time='0'><translate>0 0 0</translate></keyframe>\n"
-                           "<keyframe time='1'><scale>2</scale></keyframe>"),
-               5, "same elements in the same order");
-  expect_error(keyed_scene("<keyframe time='0'><translate>0 0 0</translate></keyframe>\n"
-                           "<keyframe time='1'><translate>0 0 0</translate><scale>2</scale></keyframe>"),
-               5, "same elements");
-  expect_error(keyed_scene("<keyframe time='0'><rotate axis='X'>0</rotate></keyframe>\n"
-                           "<keyframe time='1'><rotate axis='Y'>0</rotate></keyframe>"),
-               5, "same axis");
-  expect_error(keyed_scene("<keyframe time='1'><translate>0 0 0</translate></keyframe>\n"
-                           "<keyframe time='1'><translate>1 0 0</translate></keyframe>"),
-               5, "must increase");
-  expect_error(keyed_scene("<keyframe><translate>0 0 0</translate></keyframe>"), 4, "needs attribute 'time'");
-  expect_error(keyed_scene("<keyframe time='x'><translate>0 0 0</translate></keyframe>"), 4, "finite number");
-  expect_error(keyed_scene("<keyframe time='0'><scale>1</scale></keyframe>\n"
-                           "<keyframe time='1'><scale>0</scale></keyframe>"),
-               3, "singular");
-  expect_error(std::string("<scene>\n<mesh name='q' generator='tetra'>\n<deform type='melt'/></mesh>\n") +
-                   "<instance mesh='q'/></scene>",
-               3, "unknown deformer type 'melt'");
-  expect_error(std::string("<scene>\n<mesh name='q' generator='tetra'>\n<deform type='wave' start='1' "
-                           "end='1'/></mesh>\n<instance mesh='q'/></scene>"),
-               3, "end > start");
-  expect_error(std::string("<scene>\n<mesh name='q' generator='tetra'>\n<deform type='twist'><distance>1"
-                           "</distance></deform></mesh>\n<instance mesh='q'/></scene>"),
-               3, "unknown element <distance>");
+  test::expect_scene_error(keyed_scene("<keyframe time='0'><translate>0 0 0</translate></keyframe>\n"
+                                       "<keyframe time='1'><scale>2</scale></keyframe>"),
+                           5, "same elements in the same order");
+  test::expect_scene_error(
+      keyed_scene("<keyframe time='0'><translate>0 0 0</translate></keyframe>\n"
+                  "<keyframe time='1'><translate>0 0 0</translate><scale>2</scale></keyframe>"),
+      5, "same elements");
+  test::expect_scene_error(keyed_scene("<keyframe time='0'><rotate axis='X'>0</rotate></keyframe>\n"
+                                       "<keyframe time='1'><rotate axis='Y'>0</rotate></keyframe>"),
+                           5, "same axis");
+  test::expect_scene_error(keyed_scene("<keyframe time='1'><translate>0 0 0</translate></keyframe>\n"
+                                       "<keyframe time='1'><translate>1 0 0</translate></keyframe>"),
+                           5, "must increase");
+  test::expect_scene_error(keyed_scene("<keyframe><translate>0 0 0</translate></keyframe>"), 4,
+                           "needs attribute 'time'");
+  test::expect_scene_error(keyed_scene("<keyframe time='x'><translate>0 0 0</translate></keyframe>"), 4,
+                           "finite number");
+  test::expect_scene_error(keyed_scene("<keyframe time='0'><scale>1</scale></keyframe>\n"
+                                       "<keyframe time='1'><scale>0</scale></keyframe>"),
+                           3, "singular");
+  test::expect_scene_error(
+      std::string("<scene>\n<mesh name='q' generator='tetra'>\n<deform type='melt'/></mesh>\n") +
+          "<instance mesh='q'/></scene>",
+      3, "unknown deformer type 'melt'");
+  test::expect_scene_error(
+      std::string("<scene>\n<mesh name='q' generator='tetra'>\n<deform type='wave' start='1' "
+                  "end='1'/></mesh>\n<instance mesh='q'/></scene>"),
+      3, "end > start");
+  test::expect_scene_error(
+      std::string("<scene>\n<mesh name='q' generator='tetra'>\n<deform type='twist'><distance>1"
+                  "</distance></deform></mesh>\n<instance mesh='q'/></scene>"),
+      3, "unknown element <distance>");
 }
 
 Mesh flake_mesh() {
@@ -386,28 +380,8 @@ TEST(AnimatedScene, ShippedAnimationsAreIdenticalToBruteOnSomeFrames) {
   }
 }
 
-/// Runs the CLI; returns the exit code and stderr.
-std::pair<int, std::string> run_cli(const std::string& args, const fs::path& dir) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  const std::string exe = bin ? bin : "build/accelbench";
-  const fs::path err = dir / "stderr.txt";
-  const int status = std::system((exe + " " + args + " >/dev/null 2>" + err.string()).c_str());
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 bool have_cli() {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  return fs::exists(bin ? bin : "build/accelbench");
+  return fs::exists(test::accelbench_exe());
 }
 
 TEST(AnimatedSceneCli, TheFrameSelectorGivesTheFlattenedFramesHits) {
@@ -420,34 +394,37 @@ TEST(AnimatedSceneCli, TheFrameSelectorGivesTheFlattenedFramesHits) {
          "<mesh name='e' generator='tetra' triangles='200'><deform type='explode'/></mesh>"
          "<instance mesh='w'/><instance mesh='e'/></scene>\n";
   const std::string frame = " --frame 3 --frames 5";
-  ASSERT_EQ(
-      run_cli("rays --scene " + scene + frame + " --kind primary --count 2000 -o " + d + "r.rays", dir.path)
-          .first,
-      0);
-  ASSERT_EQ(
-      run_cli("trace --scene " + scene + frame + " --accel bvh-sah --rays " + d + "r.rays -o " + d + "s.hits",
-              dir.path)
-          .first,
-      0);
-  ASSERT_EQ(run_cli("flatten --scene " + scene + frame + " -o " + d + "f.obj", dir.path).first, 0);
-  ASSERT_EQ(
-      run_cli("trace --mesh " + d + "f.obj --accel grid --rays " + d + "r.rays -o " + d + "m.hits", dir.path)
-          .first,
-      0);
-  ASSERT_EQ(run_cli("trace --scene " + scene + " --time 0.75 --accel kdtree-sah --rays " + d + "r.rays -o " +
-                        d + "t.hits",
-                    dir.path)
+  ASSERT_EQ(test::run_accelbench(
+                "rays --scene " + scene + frame + " --kind primary --count 2000 -o " + d + "r.rays", dir.path)
                 .first,
             0);
-  EXPECT_EQ(slurp(d + "s.hits"), slurp(d + "t.hits"));  // frame 3 of 5 is time 0.75
-  ASSERT_EQ(run_cli("trace --scene " + scene + " --accel bvh-sah --rays " + d + "r.rays -o " + d + "0.hits",
-                    dir.path)
+  ASSERT_EQ(test::run_accelbench("trace --scene " + scene + frame + " --accel bvh-sah --rays " + d +
+                                     "r.rays -o " + d + "s.hits",
+                                 dir.path)
                 .first,
             0);
-  EXPECT_NE(slurp(d + "s.hits"), slurp(d + "0.hits"));  // and differs from frame 0
+  ASSERT_EQ(test::run_accelbench("flatten --scene " + scene + frame + " -o " + d + "f.obj", dir.path).first,
+            0);
+  ASSERT_EQ(
+      test::run_accelbench(
+          "trace --mesh " + d + "f.obj --accel grid --rays " + d + "r.rays -o " + d + "m.hits", dir.path)
+          .first,
+      0);
+  ASSERT_EQ(test::run_accelbench("trace --scene " + scene + " --time 0.75 --accel kdtree-sah --rays " + d +
+                                     "r.rays -o " + d + "t.hits",
+                                 dir.path)
+                .first,
+            0);
+  EXPECT_EQ(test::read_text(d + "s.hits"), test::read_text(d + "t.hits"));  // frame 3 of 5 is time 0.75
+  ASSERT_EQ(
+      test::run_accelbench(
+          "trace --scene " + scene + " --accel bvh-sah --rays " + d + "r.rays -o " + d + "0.hits", dir.path)
+          .first,
+      0);
+  EXPECT_NE(test::read_text(d + "s.hits"), test::read_text(d + "0.hits"));  // and differs from frame 0
   const Scene parsed = load_scene(scene);
   const uint32_t first = uint32_t(parsed.meshes[0].mesh->size());
-  const std::string sh = slurp(d + "s.hits"), mh = slurp(d + "m.hits");
+  const std::string sh = test::read_text(d + "s.hits"), mh = test::read_text(d + "m.hits");
   ASSERT_EQ(sh.size(), mh.size());
   size_t found = 0;
   for (size_t off = 16; off + 20 <= sh.size(); off += 20) {
@@ -472,8 +449,10 @@ TEST(AnimatedSceneCli, BadFramesAndBadAnimationsExitTwoWithOneLine) {
   std::ofstream(bad) << keyed_scene(
       "<keyframe time='0'><translate>0 0 0</translate></keyframe>\n"
       "<keyframe time='1'><scale>2</scale></keyframe>");
-  ASSERT_EQ(
-      run_cli("rays --scene " + scene + " --kind primary --count 50 -o " + d + "r.rays", dir.path).first, 0);
+  ASSERT_EQ(test::run_accelbench("rays --scene " + scene + " --kind primary --count 50 -o " + d + "r.rays",
+                                 dir.path)
+                .first,
+            0);
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"flatten --scene " + scene + " --frame 5 --frames 5 -o " + d + "o.obj", "out of range"},
       {"flatten --scene " + scene + " --frame 1 -o " + d + "o.obj", "--frame F needs --frames N"},
@@ -487,7 +466,7 @@ TEST(AnimatedSceneCli, BadFramesAndBadAnimationsExitTwoWithOneLine) {
       {"render --scene " + scene + " --frames 29-30 -o " + d + "o_%d.png", "out of range"},
   };
   for (const auto& [cmd, words] : cases) {
-    const auto [code, err] = run_cli(cmd, dir.path);
+    const auto [code, err] = test::run_accelbench(cmd, dir.path);
     EXPECT_EQ(code, 2) << cmd << ": " << err;
     EXPECT_NE(err.find(words), std::string::npos) << cmd << ": " << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
@@ -502,20 +481,21 @@ TEST(AnimatedSceneCli, RenderFramesWritesOnePngPerFrameOnAnyThreadCount) {
   const std::string scene = (dir.path / "a.xml").string(), d = dir.path.string() + "/";
   std::ofstream(scene) << animated_scene_xml();
   const std::string common = "render --scene " + scene + " --width 24 --height 16 --spp 1 --frames 1-2 ";
-  ASSERT_EQ(run_cli(common + "--threads 1 -o " + d + "one_%02d.png", dir.path).first, 0);
-  ASSERT_EQ(run_cli(common + "--threads 2 -o " + d + "two_%02d.png", dir.path).first, 0);
+  ASSERT_EQ(test::run_accelbench(common + "--threads 1 -o " + d + "one_%02d.png", dir.path).first, 0);
+  ASSERT_EQ(test::run_accelbench(common + "--threads 2 -o " + d + "two_%02d.png", dir.path).first, 0);
   EXPECT_FALSE(fs::exists(dir.path / "one_00.png"));
   for (const char* f : {"01", "02"}) {
     ASSERT_TRUE(fs::exists(dir.path / ("one_" + std::string(f) + ".png"))) << f;
-    EXPECT_EQ(slurp(d + "one_" + f + ".png"), slurp(d + "two_" + f + ".png")) << f;
+    EXPECT_EQ(test::read_text(d + "one_" + f + ".png"), test::read_text(d + "two_" + f + ".png")) << f;
   }
-  EXPECT_NE(slurp(d + "one_01.png"), slurp(d + "one_02.png"));
-  ASSERT_EQ(run_cli("render --scene " + scene + " --width 24 --height 16 --spp 1 --frame 2 --frames 30 -o " +
-                        d + "single.png",
-                    dir.path)
-                .first,
-            0);
-  EXPECT_EQ(slurp(d + "single.png"), slurp(d + "one_02.png"));
+  EXPECT_NE(test::read_text(d + "one_01.png"), test::read_text(d + "one_02.png"));
+  ASSERT_EQ(
+      test::run_accelbench("render --scene " + scene +
+                               " --width 24 --height 16 --spp 1 --frame 2 --frames 30 -o " + d + "single.png",
+                           dir.path)
+          .first,
+      0);
+  EXPECT_EQ(test::read_text(d + "single.png"), test::read_text(d + "one_02.png"));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "harness/hitfile.h"
+#include "tests/cli_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -24,18 +25,10 @@ struct Result {
   std::string err;
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    const char* bin = std::getenv("ACCELBENCH_BIN");
-    bin_ = bin ? bin : "build/accelbench";
+    bin_ = test::accelbench_exe();
     if (!fs::exists(bin_)) GTEST_SKIP() << "accelbench binary not found at " << bin_;
     dir_ = fs::temp_directory_path() / ("accelbench_cli_" + std::to_string(::getpid()) + "_" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -46,8 +39,8 @@ class Cli : public ::testing::Test {
   Result run(const std::string& args) {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
     const std::string cmd = bin_ + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    const int code = test::shell(cmd);
+    return {code, test::read_text(out), test::read_text(err)};
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   void expect_bad_input(const Result& r, const std::string& names) {
@@ -85,7 +78,7 @@ TEST_F(Cli, HelpAndListWork) {
 TEST_F(Cli, GenerateRaysTraceRoundTripIsDeterministic) {
   ASSERT_EQ(run("generate sphereflake --triangles 2000 --seed 3 -o " + path("a.obj")).code, 0);
   ASSERT_EQ(run("generate sphereflake --triangles 2000 --seed 3 -o " + path("b.obj")).code, 0);
-  EXPECT_EQ(slurp(path("a.obj")), slurp(path("b.obj")));
+  EXPECT_EQ(test::read_text(path("a.obj")), test::read_text(path("b.obj")));
   ASSERT_EQ(run("rays --mesh " + path("a.obj") + " --kind primary --count 3000 -o " + path("r.rays")).code,
             0);
   EXPECT_EQ(read_rays(path("r.rays")).size(), 3000u);
@@ -93,8 +86,8 @@ TEST_F(Cli, GenerateRaysTraceRoundTripIsDeterministic) {
   ASSERT_EQ(run(base + " --accel brute --threads 1 -o " + path("b1.hits")).code, 0);
   ASSERT_EQ(
       run(base + " --accel brute --threads 2 -o " + path("b2.hits") + " --stats " + path("s.json")).code, 0);
-  EXPECT_EQ(slurp(path("b1.hits")), slurp(path("b2.hits")));
-  const auto stats = nlohmann::json::parse(slurp(path("s.json")));
+  EXPECT_EQ(test::read_text(path("b1.hits")), test::read_text(path("b2.hits")));
+  const auto stats = nlohmann::json::parse(test::read_text(path("s.json")));
   for (const char* key :
        {"accelerator", "params", "triangles", "build_seconds", "trace_seconds", "rays_per_second", "per_ray"})
     EXPECT_TRUE(stats.contains(key)) << key;
@@ -106,7 +99,7 @@ TEST_F(Cli, BadInputGivesExitTwoOneLineAndNoOutput) {
   ASSERT_EQ(run("generate soup --triangles 100 -o " + path("m.obj")).code, 0);
   ASSERT_EQ(run("rays --mesh " + path("m.obj") + " --kind incoherent --count 10 -o " + path("r.rays")).code,
             0);
-  const std::string good_rays = slurp(path("r.rays"));
+  const std::string good_rays = test::read_text(path("r.rays"));
   auto write = [&](const std::string& name, const std::string& bytes) {
     std::ofstream(path(name), std::ios::binary) << bytes;
   };

@@ -4,11 +4,12 @@
 #include "harness/compare_runs.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+
+#include "tests/cli_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -111,8 +112,7 @@ TEST(CompareRuns, WithoutRepetitionsAChangeIsUntested) {
 
 /// The CLI: exit 1 on a regression, 0 without, 2 on bad input; --json and --csv written.
 TEST(CompareRuns, CommandExitCodesAndOutputs) {
-  const char* bin_env = std::getenv("ACCELBENCH_BIN");
-  const std::string bin = bin_env ? bin_env : "build/accelbench";
+  const std::string bin = test::accelbench_exe();
   if (!std::filesystem::exists(bin)) GTEST_SKIP() << "accelbench binary not found at " << bin;
   const auto dir =
       std::filesystem::temp_directory_path() / ("accelbench_compare_" + std::to_string(::getpid()));
@@ -122,10 +122,7 @@ TEST(CompareRuns, CommandExitCodesAndOutputs) {
   write(dir / "slower.json", report({row("bvh-sah", 1, kSlower)}, kBase));
   write(dir / "same.json", report({row("bvh-sah", 1, kNoise)}, kBase));
   std::ofstream(dir / "bad.json") << "{ not json";
-  auto run = [&](const std::string& args) {
-    const int s = std::system((bin + " compare " + args + " >/dev/null 2>" + (dir / "err").string()).c_str());
-    return WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  };
+  auto run = [&](const std::string& args) { return test::run_accelbench("compare " + args, dir).first; };
   const std::string base = (dir / "base").string();
   EXPECT_EQ(run(base + " " + (dir / "slower.json").string() + " --json " + (dir / "t.json").string() +
                 " --csv " + (dir / "t.csv").string()),

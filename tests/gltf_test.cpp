@@ -4,7 +4,6 @@
 #include "tracer/gltf.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <tiny_gltf.h>
 
 #include <cstring>
@@ -15,6 +14,7 @@
 #include "accel/core/error.h"
 #include "accel/core/registry.h"
 #include "accel/core/trace.h"
+#include "tests/cli_test_helpers.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"
 
@@ -256,8 +256,7 @@ TEST(Gltf, MalformedModelsAreOneLineErrors) {
 TEST(Gltf, MalformedFilesAreOneLineErrors) {
   TempDir dir("files");
   write_model(small_model(), dir / "ok.glb");
-  std::ifstream in(dir / "ok.glb", std::ios::binary);
-  const std::string glb{std::istreambuf_iterator<char>(in), {}};
+  const std::string glb = test::read_text(dir / "ok.glb");
   const std::vector<std::pair<std::string, std::string>> files = {
       {"half.glb", glb.substr(0, glb.size() / 2)},
       {"head.glb", glb.substr(0, 12)},
@@ -282,9 +281,7 @@ TEST(Gltf, TheShippedGltfSceneIsWhatExportWrites) {
   const fs::path dir = fs::path(ACCELBENCH_SOURCE_DIR) / "datasets" / "scenes";
   TempDir tmp("shipped");
   write_gltf_scene(load_scene((dir / "carousel.xml").string()), tmp / "c.glb");
-  std::ifstream a(dir / "carousel.glb", std::ios::binary), b(tmp / "c.glb", std::ios::binary);
-  const std::string shipped{std::istreambuf_iterator<char>(a), {}},
-      fresh{std::istreambuf_iterator<char>(b), {}};
+  const std::string shipped = test::read_text(dir / "carousel.glb"), fresh = test::read_text(tmp / "c.glb");
   EXPECT_EQ(shipped, fresh) << "regenerate: accelbench export --scene carousel.xml -o carousel.glb";
   const Scene s = load_scene((dir / "carousel.glb").string());
   EXPECT_TRUE(s.animated());
@@ -296,8 +293,7 @@ TEST(Gltf, CorruptedFilesLoadOrFailWithOneLine) {
   // Random byte flips and truncations of a real file: every load either gives a scene whose frames
   // evaluate, or one InputError line naming the file; nothing crashes or reads out of bounds.
   const fs::path dir = fs::path(ACCELBENCH_SOURCE_DIR) / "datasets" / "scenes";
-  std::ifstream in(dir / "carousel.glb", std::ios::binary);
-  const std::string glb{std::istreambuf_iterator<char>(in), {}};
+  const std::string glb = test::read_text(dir / "carousel.glb");
   ASSERT_GT(glb.size(), 1000u);
   TempDir tmp("fuzz");
   const std::string file = tmp / "f.glb";
@@ -323,23 +319,12 @@ TEST(Gltf, CorruptedFilesLoadOrFailWithOneLine) {
   EXPECT_GT(loaded + rejected, 299);
 }
 
-std::pair<int, std::string> run_cli(const std::string& args, const fs::path& dir) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  const std::string exe = bin ? bin : "build/accelbench";
-  const fs::path err = dir / "stderr.txt";
-  const int status = std::system((exe + " " + args + " >/dev/null 2>" + err.string()).c_str());
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
 TEST(GltfCli, EverySceneCommandTakesGltf) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  if (!fs::exists(bin ? bin : "build/accelbench")) GTEST_SKIP() << "accelbench binary not found";
+  if (!fs::exists(test::accelbench_exe())) GTEST_SKIP() << "accelbench binary not found";
   TempDir dir("cli");
   std::ofstream(dir / "r.xml") << kRigid;
-  ASSERT_EQ(run_cli("export --scene " + dir / "r.xml" + " -o " + dir / "r.glb", dir.path).first, 0);
+  ASSERT_EQ(test::run_accelbench("export --scene " + dir / "r.xml" + " -o " + dir / "r.glb", dir.path).first,
+            0);
   const std::string g = " --scene " + dir / "r.glb", frame = " --frame 1 --frames 3";
   for (const std::string& cmd :
        {"rays" + g + frame + " --kind primary --count 500 -o " + dir / "r.rays",
@@ -347,11 +332,12 @@ TEST(GltfCli, EverySceneCommandTakesGltf) {
         "verify" + g + frame + " --accel bvh-sah,grid --rays " + dir / "r.rays",
         "flatten" + g + " --time 0.5 -o " + dir / "f.obj",
         "render" + g + frame + " --width 16 --height 16 --spp 1 -o " + dir / "i.png"}) {
-    const auto [code, err] = run_cli(cmd, dir.path);
+    const auto [code, err] = test::run_accelbench(cmd, dir.path);
     EXPECT_EQ(code, 0) << cmd << ": " << err;
   }
   std::ofstream(dir / "bad.glb", std::ios::binary) << "glTF\x02";
-  const auto [code, err] = run_cli("flatten --scene " + dir / "bad.glb" + " -o " + dir / "o.obj", dir.path);
+  const auto [code, err] =
+      test::run_accelbench("flatten --scene " + dir / "bad.glb" + " -o " + dir / "o.obj", dir.path);
   EXPECT_EQ(code, 2) << err;
   EXPECT_NE(err.find("bad.glb: malformed glTF"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;

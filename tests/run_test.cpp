@@ -19,6 +19,7 @@
 #include "accel/core/registry.h"
 #include "accel/reference/brute.h"
 #include "harness/cli.h"
+#include "tests/cli_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -56,23 +57,8 @@ class BrokenBrute final : public AcceleratorBase<BrokenBrute<P>> {
 
 const Registrar kRegisterBroken{structure_info<BrokenBrute>("test-broken", "test only: corrupts hits", 1000)};
 
-std::string bin() {
-  const char* b = std::getenv("ACCELBENCH_BIN");
-  return b ? b : "";
-}
-
-/// Runs a shell command; returns its exit code.
-int shell(const std::string& cmd) {
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::read_text;
+using test::shell;
 
 std::vector<std::string> split_csv_line(const std::string& line) {
   std::vector<std::string> cells;
@@ -129,10 +115,11 @@ void expect_csv_matches_json(const json& report, const std::string& csv_text) {
 }
 
 TEST(Run, QuickSuiteEndToEnd) {
-  if (bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
+  if (test::accelbench_bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
   const std::string dir = fresh_dir("quick");
   const std::string suite = std::string(ACCELBENCH_SOURCE_DIR) + "/suites/quick.json";
-  ASSERT_EQ(shell("'" + bin() + "' run '" + suite + "' -o '" + dir + "' --no-plot > '" + dir + ".out' 2>&1"),
+  ASSERT_EQ(shell("'" + test::accelbench_bin() + "' run '" + suite + "' -o '" + dir + "' --no-plot > '" +
+                  dir + ".out' 2>&1"),
             0)
       << read_text(dir + ".out");
   const json report = json::parse(read_text(dir + "/report.json"));
@@ -166,12 +153,13 @@ TEST(Run, QuickSuiteEndToEnd) {
 }
 
 TEST(Run, BadSuiteExitsTwoBeforeAnyWork) {
-  if (bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
+  if (test::accelbench_bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
   const std::string dir = fresh_dir("bad");
   const std::string suite = dir + ".json";
   std::ofstream(suite) << R"({"scenes": [{"generator": "soup", "triangles": 100}],
     "accelerators": ["brute", "bvh-sah", "foo"], "rays": [{"kind": "primary", "count": 8}]})";
-  ASSERT_EQ(shell("'" + bin() + "' run '" + suite + "' -o '" + dir + "' 2> '" + dir + ".err'"), 2);
+  ASSERT_EQ(
+      shell("'" + test::accelbench_bin() + "' run '" + suite + "' -o '" + dir + "' 2> '" + dir + ".err'"), 2);
   const std::string err = read_text(dir + ".err");
   EXPECT_NE(err.find(suite + ": accelerators[2].name: unknown accelerator 'foo'"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
@@ -212,7 +200,7 @@ TEST(Run, BrokenAcceleratorFailsTheRunLoudly) {
 }
 
 TEST(Run, InterruptKeepsFinishedCases) {
-  if (bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
+  if (test::accelbench_bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
   const std::string dir = fresh_dir("interrupt");
   const std::string suite = dir + ".json";
   std::ofstream(suite) << R"({"repetitions": 3, "threads": [1], "min_time": 0.05,
@@ -221,7 +209,7 @@ TEST(Run, InterruptKeepsFinishedCases) {
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
-    const std::string b = bin();
+    const std::string b = test::accelbench_bin();
     ::freopen("/dev/null", "w", stdout);
     ::execl(b.c_str(), b.c_str(), "run", suite.c_str(), "-o", dir.c_str(), "--no-plot", (char*)nullptr);
     ::_exit(127);

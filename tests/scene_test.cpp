@@ -4,7 +4,6 @@
 #include "tracer/scene.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -16,6 +15,8 @@
 #include "accel/core/registry.h"
 #include "accel/core/trace.h"
 #include "accel/reference/embree_scene.h"
+#include "tests/cli_test_helpers.h"
+#include "tests/scene_test_helpers.h"
 #include "tracer/sampling.h"
 #include "tracer/scene_accel.h"
 #include "tracer/workload.h"
@@ -74,18 +75,6 @@ std::vector<Ray> scene_rays(const Scene& scene, size_t n) {
   return rays;
 }
 
-void expect_error(const std::string& xml, int line, const std::string& words) {
-  try {
-    parse_scene(xml, "bad.xml", ".");
-    ADD_FAILURE() << "no error for: " << xml;
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("bad.xml:" + std::to_string(line) + ": ", 0), 0u) << msg;
-    EXPECT_NE(msg.find(words), std::string::npos) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-  }
-}
-
 const char* kQuad =
     "<mesh name='q'><vertices>0 0 0 1 0 0 0 1 0</vertices><triangles>0 1 2</triangles></mesh>\n";
 
@@ -108,40 +97,41 @@ TEST(Scene, ParsesEverything) {
 }
 
 TEST(Scene, ErrorsNameTheFileAndLine) {
-  expect_error("<scene>\n<instance mesh='q'/>\n<oops>\n</scene>", 4, "malformed XML");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='nope'/>\n</scene>", 3,
-               "unknown mesh 'nope'");
-  expect_error(std::string("<scene>\n") + kQuad + "\n<instance mesh='q' material='m'/></scene>", 4,
-               "unknown material 'm'");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q' transform='t'/></scene>", 3,
-               "unknown transform 't'");
-  expect_error(std::string("<scene>\n") + kQuad +
-                   "<instance mesh='q'>\n<translate>1 2 x</translate></instance></scene>",
-               4, "bad number 'x'");
-  expect_error(
+  test::expect_scene_error("<scene>\n<instance mesh='q'/>\n<oops>\n</scene>", 4, "malformed XML");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad + "<instance mesh='nope'/>\n</scene>", 3,
+                           "unknown mesh 'nope'");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad + "\n<instance mesh='q' material='m'/></scene>",
+                           4, "unknown material 'm'");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad + "<instance mesh='q' transform='t'/></scene>", 3,
+                           "unknown transform 't'");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad +
+                               "<instance mesh='q'>\n<translate>1 2 x</translate></instance></scene>",
+                           4, "bad number 'x'");
+  test::expect_scene_error(
       std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<translate>1 2</translate></instance></scene>",
       4, "needs 3 numbers");
-  expect_error(
+  test::expect_scene_error(
       std::string("<scene>\n") + kQuad + "<instance mesh='q'>\n<scale>1 nan 1</scale></instance></scene>", 4,
       "bad number 'nan'");
-  expect_error(
+  test::expect_scene_error(
       std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n<camera><fov>500</fov></camera></scene>", 4,
       "fov");
-  expect_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n\n<lamp/></scene>", 5,
-               "unknown element <lamp>");
-  expect_error(
+  test::expect_scene_error(std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n\n<lamp/></scene>", 5,
+                           "unknown element <lamp>");
+  test::expect_scene_error(
       std::string("<scene>\n") + kQuad + "<instance mesh='q'/>\n<material name='m' type='velvet'/></scene>",
       4, "velvet");
-  expect_error(
+  test::expect_scene_error(
       "<scene>\n<mesh name='q'><vertices>0 0 0</vertices>\n<triangles>0 1 2</triangles></mesh></scene>", 3,
       "out of range");
-  expect_error("<scene>\n<mesh name='g' generator='no-such-generator'/>\n</scene>", 2, "no-such-generator");
-  expect_error("<scene>\n<mesh name='f' file='missing.obj'/>\n</scene>", 2, "missing.obj");
-  expect_error(std::string("<scene>\n") + kQuad + kQuad + "</scene>", 3, "declared twice");
-  expect_error(std::string("<scene>\n") + kQuad + "</scene>", 1, "no <instance>");
-  expect_error(std::string("<scene>\n") + kQuad +
-                   "<instance mesh='q'>\n<rotate axis='W'>3</rotate></instance></scene>",
-               4, "axis");
+  test::expect_scene_error("<scene>\n<mesh name='g' generator='no-such-generator'/>\n</scene>", 2,
+                           "no-such-generator");
+  test::expect_scene_error("<scene>\n<mesh name='f' file='missing.obj'/>\n</scene>", 2, "missing.obj");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad + kQuad + "</scene>", 3, "declared twice");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad + "</scene>", 1, "no <instance>");
+  test::expect_scene_error(std::string("<scene>\n") + kQuad +
+                               "<instance mesh='q'>\n<rotate axis='W'>3</rotate></instance></scene>",
+                           4, "axis");
 }
 
 TEST(Scene, EachBaseMeshIsLoadedAndBuiltOnce) {
@@ -349,21 +339,8 @@ TEST(Scene, RealMeshSceneLoadsWhereTheMeshesAre) {
   }
 }
 
-/// Runs the CLI; returns the exit code and stderr.
-std::pair<int, std::string> run_cli(const std::string& args, const fs::path& dir) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  const std::string exe = bin ? bin : "build/accelbench";
-  const fs::path err = dir / "stderr.txt";
-  const int status = std::system((exe + " " + args + " >/dev/null 2>" + err.string()).c_str());
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
 TEST(Scene, CliRejectsBadScenesWithOneLine) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  if (!fs::exists(bin ? bin : "build/accelbench")) GTEST_SKIP() << "accelbench binary not found";
+  if (!fs::exists(test::accelbench_exe())) GTEST_SKIP() << "accelbench binary not found";
   const fs::path dir = fs::temp_directory_path() / ("accelbench_scene_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path bad = dir / "bad.xml";
@@ -373,7 +350,7 @@ TEST(Scene, CliRejectsBadScenesWithOneLine) {
        {"render --scene " + bad.string() + " -o " + (dir / "o.png").string(),
         "flatten --scene " + bad.string() + " -o " + (dir / "o.obj").string(),
         "rays --scene " + bad.string() + " --kind primary --count 5 -o " + (dir / "o.rays").string()}) {
-    const auto [code, err] = run_cli(cmd, dir);
+    const auto [code, err] = test::run_accelbench(cmd, dir);
     EXPECT_EQ(code, 2) << cmd << ": " << err;
     EXPECT_NE(err.find("bad.xml:4:"), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
@@ -384,18 +361,20 @@ TEST(Scene, CliRejectsBadScenesWithOneLine) {
 }
 
 TEST(Scene, CliFlattenAndRaysWork) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  if (!fs::exists(bin ? bin : "build/accelbench")) GTEST_SKIP() << "accelbench binary not found";
+  if (!fs::exists(test::accelbench_exe())) GTEST_SKIP() << "accelbench binary not found";
   const fs::path dir = fs::temp_directory_path() / ("accelbench_scene_ok_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path scene = dir / "s.xml";
   std::ofstream(scene) << instanced_scene_xml(10);
-  EXPECT_EQ(run_cli("flatten --scene " + scene.string() + " -o " + (dir / "f.obj").string(), dir).first, 0);
+  EXPECT_EQ(test::run_accelbench("flatten --scene " + scene.string() + " -o " + (dir / "f.obj").string(), dir)
+                .first,
+            0);
   EXPECT_TRUE(fs::exists(dir / "f.obj"));
   for (const char* kind : {"primary", "dof", "shadow", "glossy", "diffuse"}) {
     const fs::path out = dir / (std::string(kind) + ".rays");
     EXPECT_EQ(
-        run_cli("rays --scene " + scene.string() + " --kind " + kind + " --count 100 -o " + out.string(), dir)
+        test::run_accelbench(
+            "rays --scene " + scene.string() + " --kind " + kind + " --count 100 -o " + out.string(), dir)
             .first,
         0);
     EXPECT_EQ(fs::file_size(out), 16u + 100u * 32u) << kind;
@@ -404,23 +383,18 @@ TEST(Scene, CliFlattenAndRaysWork) {
 }
 
 TEST(Scene, CliRendersTheSamePngForAnyThreadCount) {
-  const char* bin = std::getenv("ACCELBENCH_BIN");
-  if (!fs::exists(bin ? bin : "build/accelbench")) GTEST_SKIP() << "accelbench binary not found";
+  if (!fs::exists(test::accelbench_exe())) GTEST_SKIP() << "accelbench binary not found";
   const fs::path dir = fs::temp_directory_path() / ("accelbench_scene_png_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path scene = dir / "s.xml";
   std::ofstream(scene) << instanced_scene_xml(20);
   const std::string base =
       "render --scene " + scene.string() + " --width 40 --height 30 --spp 4 --accel brute";
-  EXPECT_EQ(run_cli(base + " --threads 1 -o " + (dir / "a.png").string(), dir).first, 0);
-  EXPECT_EQ(run_cli(base + " --threads 2 -o " + (dir / "b.png").string(), dir).first, 0);
-  EXPECT_EQ(run_cli(base + " --heatmap -o " + (dir / "h.png").string(), dir).first, 0);
-  auto bytes = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  EXPECT_FALSE(bytes(dir / "a.png").empty());
-  EXPECT_EQ(bytes(dir / "a.png"), bytes(dir / "b.png"));
+  EXPECT_EQ(test::run_accelbench(base + " --threads 1 -o " + (dir / "a.png").string(), dir).first, 0);
+  EXPECT_EQ(test::run_accelbench(base + " --threads 2 -o " + (dir / "b.png").string(), dir).first, 0);
+  EXPECT_EQ(test::run_accelbench(base + " --heatmap -o " + (dir / "h.png").string(), dir).first, 0);
+  EXPECT_FALSE(test::read_text(dir / "a.png").empty());
+  EXPECT_EQ(test::read_text(dir / "a.png"), test::read_text(dir / "b.png"));
   EXPECT_TRUE(fs::exists(dir / "h.png"));
   fs::remove_all(dir);
 }

@@ -4,8 +4,6 @@
 // memory aside.
 #pragma once
 
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -15,27 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "tests/cli_test_helpers.h"
+
 namespace ab::test {
-
-/// The accelbench binary (CTest sets ACCELBENCH_BIN), "" when not set.
-inline std::string accelbench_bin() {
-  const char* b = std::getenv("ACCELBENCH_BIN");
-  return b ? b : "";
-}
-
-/// Runs a shell command; returns its exit code (-1 when it did not exit).
-inline int shell(const std::string& cmd) {
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-/// A file's text ("" when it cannot be read).
-inline std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 /// A JSON file (null when it cannot be read or parsed).
 inline nlohmann::json read_json_file(const std::string& path) {

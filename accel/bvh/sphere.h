@@ -21,6 +21,7 @@
 #include "accel/bvh/sphere_entry.h"
 #include "accel/bvh/sphere_fit.h"
 #include "accel/bvh/sphere_node.h"
+#include "accel/bvh/tree_visitors.h"
 #include "accel/bvh/walk2.h"
 #include "accel/common/tree_stats.h"
 #include "accel/core/accelerator.h"
@@ -29,27 +30,9 @@
 
 namespace ab {
 
-/// The sphere tree as the one statistics walk (accel/common/tree_stats.h) sees it: nodes by index, a
-/// node's box its sphere's bounding cube (whose area ratios are the spheres').
-struct SphereTreeVisitor {
-  using Node = uint32_t;         ///< index in the node array
-  const SphereNodeArray& nodes;  ///< the tree (not empty)
-
-  /// Node 0.
-  Node root() const { return 0; }
-  /// The sphere's bounding cube.
-  AABB box(Node i) const { return nodes[i].cube(); }
-  /// True for a leaf.
-  bool is_leaf(Node i) const { return nodes[i].is_leaf(); }
-  /// Primitives of a leaf.
-  uint32_t count(Node i) const { return nodes[i].count; }
-  /// The sibling pair, right first (the walk then goes left to right).
-  template <class F>
-  void children(Node i, F&& f) const {
-    f(nodes[i].offset + 1);
-    f(nodes[i].offset);
-  }
-};
+/// The sphere tree as the one statistics walk (accel/common/tree_stats.h) sees it: a node's box its
+/// sphere's bounding cube (whose area ratios are the spheres').
+using SphereTreeVisitor = BinaryTreeVisitor<SphereNodeArray, &SphereNode::cube>;
 
 /// A bounding-sphere hierarchy over primitive set P (triangles, or instances as a top level: spheres
 /// around the instances' world boxes). Triangles are copied into leaf order, as bvh-sah width=2 does.

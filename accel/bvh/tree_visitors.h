@@ -1,4 +1,5 @@
-// The binary and the 8-wide BVH as the one statistics walk (accel/common/tree_stats.h) sees them.
+// The binary trees (BVH, sphere tree) and the 8-wide BVH as the one statistics walk
+// (accel/common/tree_stats.h) sees them.
 #pragma once
 
 #include <cstdint>
@@ -9,15 +10,17 @@
 
 namespace ab {
 
-/// The binary BVH (build_bvh's layout, not empty): nodes by index, the padding node never named.
-struct BvhTreeVisitor {
-  using Node = uint32_t;      ///< index in the node array
-  const BvhNodeArray& nodes;  ///< the tree
+/// A binary tree in build_bvh's layout (root 0, padding 1, sibling pairs; not empty) over node array Array:
+/// nodes by index, the padding node never named, a node's box its member function kBox.
+template <class Array, auto kBox>
+struct BinaryTreeVisitor {
+  using Node = uint32_t;  ///< index in the node array
+  const Array& nodes;     ///< the tree
 
   /// Node 0.
   Node root() const { return 0; }
   /// The node's box.
-  AABB box(Node i) const { return nodes[i].box(); }
+  AABB box(Node i) const { return (nodes[i].*kBox)(); }
   /// True for a leaf.
   bool is_leaf(Node i) const { return nodes[i].is_leaf(); }
   /// Primitives of a leaf.
@@ -29,6 +32,9 @@ struct BvhTreeVisitor {
     f(nodes[i].offset);
   }
 };
+
+/// The binary BVH.
+using BvhTreeVisitor = BinaryTreeVisitor<BvhNodeArray, &BvhNode::box>;
 
 /// True when lane k of a wide node holds a child: a leaf (count > 0) or a node (index > 0, as the root is
 /// no one's child). Unlike Bvh8Node::used() this does not look at the box, which is empty for a subtree of

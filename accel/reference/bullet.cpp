@@ -92,7 +92,7 @@ bool clip_to_box(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi, dou
 }  // namespace
 
 BulletMesh::BulletMesh(std::shared_ptr<const TrianglePrims> prims, const Config&)
-    : prims_(std::move(prims)) {}
+    : PeerMesh(std::move(prims)) {}
 
 BulletMesh::~BulletMesh() = default;
 
@@ -158,16 +158,15 @@ void BulletMesh::closest(const Ray& ray, Hit& best, uint32_t inst) const {
   if (h.found() && is_better_hit(h.t, inst, h.prim, best)) best = h;
 }
 
+bool BulletMesh::any(const Ray& ray) const {
+  Hit h;
+  closest(ray, h, kInvalidId);
+  return h.found();
+}
+
 namespace {
-const Registrar kRegisterBullet{[] {
-  AcceleratorInfo info;
-  info.name = "bullet";
-  info.description = "Bullet 3.24 btBvhTriangleMeshShape, quantized BVH (an outside peer, a reference)";
-  info.order = 3;
-  info.is_reference = true;
-  info.make_for_mesh = create_structure<BulletMesh>;
-  return info;
-}()};
+const Registrar kRegisterBullet{peer_info<BulletMesh>(
+    "bullet", "Bullet 3.24 btBvhTriangleMeshShape, quantized BVH (an outside peer, a reference)", 3)};
 }  // namespace
 
 }  // namespace ab

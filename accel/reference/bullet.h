@@ -5,9 +5,7 @@
 
 #include <memory>
 
-#include "accel/core/accelerator.h"
-#include "accel/core/params.h"
-#include "accel/core/primitives.h"
+#include "accel/reference/peer_mesh.h"
 
 namespace ab {
 
@@ -17,37 +15,14 @@ namespace ab {
 /// to the mesh bounds; the triangle ray-cast callback (flags kF_None) keeps the closest triangle the
 /// project's kernel confirms (peer.h), else the closest Bullet reported. Any hit is the closest hit (Bullet
 /// has no any-hit query). No traversal counters.
-class BulletMesh final : public AcceleratorBase<BulletMesh> {
+class BulletMesh final : public PeerMesh<BulletMesh> {
  public:
-  using Prims = TrianglePrims;  ///< over triangle meshes only
-  /// Bullet's mesh shape is built with its defaults: no parameters.
-  struct Config {
-    /// Reads nothing.
-    static Config read(Params&) { return {}; }
-  };
-
   /// Over prims (built by build()).
   BulletMesh(std::shared_ptr<const TrianglePrims> prims, const Config& config);
   /// Releases the shape.
   ~BulletMesh() override;
   BulletMesh(const BulletMesh&) = delete;
   BulletMesh& operator=(const BulletMesh&) = delete;
-
-  /// Bounds of the mesh.
-  AABB bounds() const override { return prims_->bounds(); }
-
-  /// Closest hit of one ray, kept in best by the acceptance rule (counters stay zero).
-  template <bool kCount>
-  void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters&) const {
-    closest(ray, best, inst);
-  }
-  /// Any hit of one ray: whether the closest hit exists.
-  template <bool kCount>
-  bool occluded_ray(const Ray& ray, RayCounters&) const {
-    Hit h;
-    closest(ray, h, kInvalidId);
-    return h.found();
-  }
 
  protected:
   /// Builds Bullet's quantized BVH over the mesh.
@@ -56,10 +31,12 @@ class BulletMesh final : public AcceleratorBase<BulletMesh> {
   void gather_stats(BuildStats& stats) const override;
 
  private:
+  friend class PeerMesh<BulletMesh>;
   struct Shape;
   void closest(const Ray& ray, Hit& best, uint32_t inst) const;
+  /// Whether the closest hit exists (Bullet has no any-hit query).
+  bool any(const Ray& ray) const;
 
-  std::shared_ptr<const TrianglePrims> prims_;
   std::unique_ptr<Shape> shape_;
 };
 

@@ -74,7 +74,7 @@ struct CgalMesh::Tree {
   AabbTree tree;
 };
 
-CgalMesh::CgalMesh(std::shared_ptr<const TrianglePrims> prims, const Config&) : prims_(std::move(prims)) {}
+CgalMesh::CgalMesh(std::shared_ptr<const TrianglePrims> prims, const Config&) : PeerMesh(std::move(prims)) {}
 
 CgalMesh::~CgalMesh() = default;
 
@@ -148,15 +148,8 @@ bool CgalMesh::any(const Ray& ray) const {
 }
 
 namespace {
-const Registrar kRegisterCgal{[] {
-  AcceleratorInfo info;
-  info.name = "cgal";
-  info.description = "CGAL 5.5 AABB_tree, Epick kernel (an outside peer, a reference)";
-  info.order = 2;
-  info.is_reference = true;
-  info.make_for_mesh = create_structure<CgalMesh>;
-  return info;
-}()};
+const Registrar kRegisterCgal{
+    peer_info<CgalMesh>("cgal", "CGAL 5.5 AABB_tree, Epick kernel (an outside peer, a reference)", 2)};
 }  // namespace
 
 }  // namespace ab

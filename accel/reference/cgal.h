@@ -4,9 +4,7 @@
 
 #include <memory>
 
-#include "accel/core/accelerator.h"
-#include "accel/core/params.h"
-#include "accel/core/primitives.h"
+#include "accel/reference/peer_mesh.h"
 
 namespace ab {
 
@@ -15,35 +13,14 @@ namespace ab {
 /// Ray_3 started at tmin; t, u, v of the triangle CGAL returns come from the project's kernel (peer.h).
 /// Zero-area (collinear) triangles are left out of the tree (CGAL asserts on them; they never hit).
 /// Any hit through CGAL's own do_intersect (a Segment_3 when tmax is finite). No traversal counters.
-class CgalMesh final : public AcceleratorBase<CgalMesh> {
+class CgalMesh final : public PeerMesh<CgalMesh> {
  public:
-  using Prims = TrianglePrims;  ///< over triangle meshes only
-  /// CGAL's tree has no parameters.
-  struct Config {
-    /// Reads nothing.
-    static Config read(Params&) { return {}; }
-  };
-
   /// Over prims (built by build()).
   CgalMesh(std::shared_ptr<const TrianglePrims> prims, const Config& config);
   /// Releases the tree.
   ~CgalMesh() override;
   CgalMesh(const CgalMesh&) = delete;
   CgalMesh& operator=(const CgalMesh&) = delete;
-
-  /// Bounds of the mesh.
-  AABB bounds() const override { return prims_->bounds(); }
-
-  /// Closest hit of one ray, kept in best by the acceptance rule (counters stay zero).
-  template <bool kCount>
-  void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters&) const {
-    closest(ray, best, inst);
-  }
-  /// Any hit of one ray within [tmin, tmax] (CGAL's do_intersect).
-  template <bool kCount>
-  bool occluded_ray(const Ray& ray, RayCounters&) const {
-    return any(ray);
-  }
 
  protected:
   /// Builds the tree over the triangles that are not collinear.
@@ -52,11 +29,12 @@ class CgalMesh final : public AcceleratorBase<CgalMesh> {
   void gather_stats(BuildStats& stats) const override;
 
  private:
+  friend class PeerMesh<CgalMesh>;
   struct Tree;
   void closest(const Ray& ray, Hit& best, uint32_t inst) const;
+  /// Any hit within [tmin, tmax] through CGAL's do_intersect.
   bool any(const Ray& ray) const;
 
-  std::shared_ptr<const TrianglePrims> prims_;
   std::unique_ptr<Tree> tree_;
   uint64_t skipped_ = 0;  ///< collinear triangles left out
 };
