@@ -57,15 +57,21 @@ std::string obj_text() {
   return s.str();
 }
 
-std::string off_text() {
+/// The vertex lines, then the face lines (count, then indices), as OFF and ASCII PLY write them.
+std::string vertex_and_face_lines() {
   std::ostringstream s;
-  s << "OFF\n" << kVertices.size() << ' ' << kFaces.size() << " 0\n";
   for (const vec3& v : kVertices) s << v.x << ' ' << v.y << ' ' << v.z << '\n';
   for (const auto& f : kFaces) {
     s << f.size();
     for (int i : f) s << ' ' << i;
     s << '\n';
   }
+  return s.str();
+}
+
+std::string off_text() {
+  std::ostringstream s;
+  s << "OFF\n" << kVertices.size() << ' ' << kFaces.size() << " 0\n" << vertex_and_face_lines();
   return s.str();
 }
 
@@ -77,13 +83,7 @@ std::string ply_header(const std::string& format, size_t vertices, size_t faces)
 
 std::string ply_ascii_text() {
   std::ostringstream s;
-  s << ply_header("ascii", kVertices.size(), kFaces.size());
-  for (const vec3& v : kVertices) s << v.x << ' ' << v.y << ' ' << v.z << '\n';
-  for (const auto& f : kFaces) {
-    s << f.size();
-    for (int i : f) s << ' ' << i;
-    s << '\n';
-  }
+  s << ply_header("ascii", kVertices.size(), kFaces.size()) << vertex_and_face_lines();
   return s.str();
 }
 

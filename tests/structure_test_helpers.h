@@ -116,6 +116,28 @@ inline std::vector<Ray> adversarial_rays(const Mesh& mesh, size_t count, uint32_
   return rays;
 }
 
+/// Builds accel and brute (over the same primitives) and compares hits (byte for byte), occlusion and the
+/// counting pass's hits. Returns the number of differences.
+inline size_t differences_from_brute(Accelerator& accel, Accelerator& brute, const std::vector<Ray>& rays) {
+  accel.build();
+  brute.build();
+  std::vector<Hit> expected(rays.size()), got(rays.size());
+  std::vector<uint8_t> expected_occ(rays.size()), got_occ(rays.size());
+  brute.intersect(rays, expected);
+  accel.intersect(rays, got);
+  brute.occluded(rays, expected_occ);
+  accel.occluded(rays, got_occ);
+  size_t diff = 0;
+  for (size_t i = 0; i < rays.size(); ++i)
+    if (std::memcmp(&expected[i], &got[i], sizeof(Hit)) != 0 || expected_occ[i] != got_occ[i]) ++diff;
+  // The counting pass must give the same hits.
+  RayCounters counters;
+  accel.intersect_counted(rays, got, counters);
+  for (size_t i = 0; i < rays.size(); ++i)
+    if (std::memcmp(&expected[i], &got[i], sizeof(Hit)) != 0) ++diff;
+  return diff;
+}
+
 /// Builds accelerator `name` over the mesh with params and checks hits (byte for byte) and occlusion
 /// against brute force. Returns the number of differing rays.
 inline size_t count_differences(const std::string& name, const Mesh& mesh, const std::vector<Ray>& rays,
@@ -123,23 +145,7 @@ inline size_t count_differences(const std::string& name, const Mesh& mesh, const
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
   auto accel = make_accelerator(name, prims, Params(std::move(params)));
   auto brute = make_accelerator("brute", prims, Params());
-  accel->build();
-  brute->build();
-  std::vector<Hit> expected(rays.size()), got(rays.size());
-  std::vector<uint8_t> expected_occ(rays.size()), got_occ(rays.size());
-  brute->intersect(rays, expected);
-  accel->intersect(rays, got);
-  brute->occluded(rays, expected_occ);
-  accel->occluded(rays, got_occ);
-  size_t diff = 0;
-  for (size_t i = 0; i < rays.size(); ++i)
-    if (std::memcmp(&expected[i], &got[i], sizeof(Hit)) != 0 || expected_occ[i] != got_occ[i]) ++diff;
-  // The counting pass must give the same hits.
-  RayCounters counters;
-  accel->intersect_counted(rays, got, counters);
-  for (size_t i = 0; i < rays.size(); ++i)
-    if (std::memcmp(&expected[i], &got[i], sizeof(Hit)) != 0) ++diff;
-  return diff;
+  return differences_from_brute(*accel, *brute, rays);
 }
 
 /// A scene of `copies` transformed instances of one base mesh built with `base_name`, returned as the
@@ -162,23 +168,13 @@ inline std::shared_ptr<const InstancePrims> make_instances(const Mesh& mesh, con
   return std::make_shared<const InstancePrims>(std::move(instances));
 }
 
-/// Top-level accelerator `name` over instances vs brute over the same instances; number of differing rays.
+/// Top-level accelerator `name` over instances vs brute over the same instances (hits, occlusion, the
+/// counting pass); number of differences.
 inline size_t count_instance_differences(const std::string& name, std::shared_ptr<const InstancePrims> inst,
                                          const std::vector<Ray>& rays) {
   auto accel = make_instance_accelerator(name, inst, Params());
   auto brute = make_instance_accelerator("brute", inst, Params());
-  accel->build();
-  brute->build();
-  std::vector<Hit> expected(rays.size()), got(rays.size());
-  std::vector<uint8_t> expected_occ(rays.size()), got_occ(rays.size());
-  brute->intersect(rays, expected);
-  accel->intersect(rays, got);
-  brute->occluded(rays, expected_occ);
-  accel->occluded(rays, got_occ);
-  size_t diff = 0;
-  for (size_t i = 0; i < rays.size(); ++i)
-    if (std::memcmp(&expected[i], &got[i], sizeof(Hit)) != 0 || expected_occ[i] != got_occ[i]) ++diff;
-  return diff;
+  return differences_from_brute(*accel, *brute, rays);
 }
 
 }  // namespace ab::testing
