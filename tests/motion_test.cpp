@@ -2,7 +2,10 @@
 // moving-instance bounds, and every registered structure byte-identical to brute on rays with times over
 // deforming meshes and moving instances (flattened and two-level scenes, 1 and 2 threads). New structures
 // are covered by registering.
+#include "accel/bvh/motion.h"
+
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstring>
@@ -350,6 +353,124 @@ TEST(MotionScene, RenderIsTheSameOnAnyThreadCountAndShowsBlur) {
   still_accel->build();
   const Image sharp = render(*still, *still_accel, o);
   EXPECT_NE(std::memcmp(one.pixels.data(), sharp.pixels.data(), one.pixels.size() * sizeof(vec3)), 0);
+}
+
+TEST(MotionBvh, PrimitivesThatDoNotMoveGetTheStaticTree) {
+  const Mesh base = soup(300, 21);
+  auto fixed = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(base));
+  auto moving = std::make_shared<const MotionTrianglePrims>(deforming_steps(base, 3, 0.2f, 22));
+  const auto same = std::make_shared<const Mesh>(base);
+  auto still =
+      std::make_shared<const MotionTrianglePrims>(std::vector<std::shared_ptr<const Mesh>>{same, same});
+  BvhMotion<TrianglePrims> over_fixed(fixed, BvhMotionConfig{});
+  BvhMotion<MotionTrianglePrims> over_moving(moving, BvhMotionConfig{}), over_still(still, BvhMotionConfig{});
+  over_fixed.build(), over_moving.build(), over_still.build();
+  EXPECT_TRUE(over_fixed.uses_static_tree());
+  EXPECT_FALSE(over_moving.uses_static_tree());
+  EXPECT_TRUE(over_still.uses_static_tree());
+  EXPECT_EQ(over_fixed.stats().extra["static_tree"], true);
+  EXPECT_EQ(over_moving.stats().extra["static_tree"], false);
+  auto brute_still = make_motion_accelerator("brute", still, Params{});
+  brute_still->build();
+  expect_same_as_brute(over_still, *brute_still, timed_rays(still.get(), still->bounds(), 1000, 23),
+                       "bvh-motion over a mesh that does not move");
+  auto brute = make_motion_accelerator("brute", moving, Params{});
+  brute->build();
+  auto fixed_brute = make_accelerator("brute", fixed, Params{});
+  fixed_brute->build();
+  const auto instances = moving_instances(std::move(brute), std::move(fixed_brute));
+  std::vector<Instance> fixed_list;
+  for (size_t i = 0; i < instances->size(); ++i)
+    if (!instances->instance(i).moves()) fixed_list.push_back(instances->instance(i));
+  BvhMotion<InstancePrims> top_moving(instances, BvhMotionConfig{});
+  BvhMotion<InstancePrims> top_fixed(std::make_shared<const InstancePrims>(fixed_list), BvhMotionConfig{});
+  top_moving.build(), top_fixed.build();
+  EXPECT_FALSE(top_moving.uses_static_tree());
+  EXPECT_TRUE(top_fixed.uses_static_tree());
+}
+
+TEST(MotionBvh, TheWideNodeEntersALaneOnlyAtTimesInItsRange) {
+  const LinearBounds lb{AABB{vec3(0.0f), vec3(1.0f)}, AABB{vec3(2.0f, 0.0f, 0.0f), vec3(3.0f, 1.0f, 1.0f)}};
+  MotionBvh8Node node;
+  node.set(0, MotionBvhNode::make(lb, 0.0f, 0.5f));
+  node.set(1, MotionBvhNode::make(lb, 0.5f, 1.0f));
+  node.count[0] = node.count[1] = 1;
+  Ray ray;
+  ray.org = vec3(-5.0f, 0.5f, 0.5f), ray.dir = vec3(1.0f, 0.0f, 0.0f);
+  for (float time : {0.0f, 0.25f, 0.5f, 0.75f, 1.0f}) {
+    ray.time = time;
+    const MotionBvh8RayTest test(ray);
+    alignas(32) float t[8];
+    const unsigned mask = test.entries(node, kInf, t);
+    EXPECT_EQ(mask, (time <= 0.5f ? 1u : 0u) | (time >= 0.5f ? 2u : 0u)) << time;
+    EXPECT_EQ(test.entries_scalar(node, kInf, t), mask) << time;
+    const float f = time <= 0.5f ? time / 0.5f : (time - 0.5f) / 0.5f;     // lane 0 or 1's fraction
+    EXPECT_NEAR(t[time <= 0.5f ? 0 : 1], 5.0f + 2.0f * f, 1e-3f) << time;  // enters its box at that time
+  }
+}
+
+/// Triangles far from the origin whose top edges all move alike in y, and rays parallel to x and z exactly
+/// on the edge at the ray's time: the interpolated boxes end on the edge's y to within rounding, so only the
+/// margin (kMotionBoxEps) keeps them from culling the hit.
+TEST(MotionBvh, RaysOnAMovingEdgeAreNotCulledByRounding) {
+  std::vector<std::shared_ptr<const Mesh>> steps;
+  for (const float y : {1000.0f, 1003.3f, 999.1f}) {
+    Mesh m;
+    for (uint32_t i = 0; i < 64; ++i) {
+      const float x = 1000.0f + float(i % 8), z = 1000.0f + float(i / 8);
+      m.vertices.push_back({x, y - 0.7f, z});
+      m.vertices.push_back({x - 0.4f, y, z});
+      m.vertices.push_back({x + 0.4f, y, z});
+      m.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
+    }
+    steps.push_back(std::make_shared<const Mesh>(std::move(m)));
+  }
+  auto prims = std::make_shared<const MotionTrianglePrims>(steps);
+  Rng rng(31);
+  std::vector<Ray> rays;
+  for (int k = 0; k < 4000; ++k) {
+    Ray r;
+    r.time = rng.uniform();
+    const size_t i = rng.below(prims->size());
+    const Triangle t = prims->triangle_at(i, r.time);
+    const float along = 0.9f * (rng.uniform() - 0.5f);
+    r.org = 0.5f * (t.v1 + t.v2) + vec3(0.4f * along, 0.0f, -0.5f);
+    r.dir = vec3(0.0f, 0.0f, 1.0f);
+    rays.push_back(r);
+  }
+  auto brute = make_motion_accelerator("brute", prims, Params{});
+  brute->build();
+  for (const char* width : {"8", "2"}) {
+    Params p;
+    p.set("width", width);
+    auto accel = make_motion_accelerator("bvh-motion", prims, p);
+    accel->build();
+    expect_same_as_brute(*accel, *brute, rays, std::string("bvh-motion width ") + width);
+  }
+}
+
+TEST(MotionBvh, BinaryWidthIsBruteAndTheParallelBuildIsTheSerialTree) {
+  auto prims = std::make_shared<const MotionTrianglePrims>(deforming_steps(soup(3000, 41), 5, 0.3f, 42));
+  Params p;
+  p.set("width", "2");
+  auto binary = make_motion_accelerator("bvh-motion", prims, p);
+  binary->build();
+  auto brute = make_motion_accelerator("brute", prims, Params{});
+  brute->build();
+  expect_same_as_brute(*binary, *brute, timed_rays(prims.get(), prims->bounds(), 1500, 43), "width 2");
+  const auto wide_tree = [&](size_t threshold, int threads) {
+    BvhMotionConfig c;
+    c.parallel_threshold = threshold;
+    BvhMotion<MotionTrianglePrims> accel(prims, c);
+    tbb::task_arena(threads).execute([&] { accel.build(); });
+    const MotionBvh8NodeArray& nodes = accel.wide_nodes();
+    return std::vector<char>(reinterpret_cast<const char*>(nodes.data()),
+                             reinterpret_cast<const char*>(nodes.data() + nodes.size()));
+  };
+  const std::vector<char> serial = wide_tree(size_t(1) << 40, 1);
+  EXPECT_GT(serial.size(), 10 * sizeof(MotionBvh8Node));
+  EXPECT_EQ(wide_tree(64, 1), serial);
+  EXPECT_EQ(wide_tree(64, 2), serial);
 }
 
 INSTANTIATE_TEST_SUITE_P(Structures, MotionConformance, ::testing::ValuesIn(structure_names()),

@@ -4,8 +4,14 @@
 // (both children get every primitive, each over half of the range at the time step nearest its middle),
 // whichever the SAH over time-weighted areas prices lower: an object split costs
 // A(left) N_l + A(right) N_r, a temporal split w_l A(left) N + w_r A(right) N with w the children's shares
-// of the range, A the area of a linear bound's middle box (Embree's expected half area).
+// of the range, A the area of a linear bound's middle box (Embree's expected half area). Large nodes build
+// their children in parallel (TBB), each into a tree of its own that is then appended, whatever the number
+// of threads: the same tree for any thread count.
 #pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
@@ -31,6 +37,7 @@ struct MotionBuildSettings {
   int bins = 16;
   int max_leaf_size = 8;
   int max_depth = 64;
+  size_t parallel_threshold = 4096;  ///< nodes at least this large build their children in parallel
 };
 
 /// Builds over primitive set P (motion_bounds.h gives each primitive's steps).
@@ -64,15 +71,30 @@ class MotionBvhBuilder {
     int bin = 0;
   };
 
+  /// The items of ids over [t0, t1] (in parallel for large nodes) and their union into all.
+  std::vector<Item> make_items(const std::vector<uint32_t>& ids, float t0, float t1,
+                               LinearBounds& all) const {
+    std::vector<Item> items(ids.size());
+    const auto fill = [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        items[k] = {ids[k], prim_linear_bounds(prims_, ids[k], t0, t1), {}};
+        items[k].centroid = items[k].lb.middle().center();
+      }
+    };
+    if (ids.size() >= settings_.parallel_threshold)
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 1024),
+                        [&](const tbb::blocked_range<size_t>& r) { fill(r.begin(), r.end()); });
+    else
+      fill(0, ids.size());
+    all = {AABB{}, AABB{}};
+    for (const Item& it : items) all.extend(it.lb);
+    return items;
+  }
+
   /// Node `index` over ids on [t0, t1]: a leaf, or a temporal or object split into a new sibling pair.
   void build_node(const std::vector<uint32_t>& ids, float t0, float t1, int depth, uint32_t index) {
-    std::vector<Item> items(ids.size());
-    LinearBounds all{AABB{}, AABB{}};
-    for (size_t k = 0; k < ids.size(); ++k) {
-      items[k] = {ids[k], prim_linear_bounds(prims_, ids[k], t0, t1), {}};
-      items[k].centroid = items[k].lb.middle().center();
-      all.extend(items[k].lb);
-    }
+    LinearBounds all;
+    std::vector<Item> items = make_items(ids, t0, t1, all);
     out_.nodes[index] = MotionBvhNode::make(all, t0, t1);
     const size_t n = items.size();
     const float area = std::max(all.middle().area(), 1e-30f);
@@ -87,16 +109,50 @@ class MotionBvhBuilder {
     const auto pair = static_cast<uint32_t>(out_.nodes.size());
     out_.nodes.resize(pair + 2);
     out_.nodes[index].offset = pair;
-    if (temporal < object.cost) {
-      build_node(ids, t0, tm, depth + 1, pair);
-      build_node(ids, tm, t1, depth + 1, pair + 1);
-      return;
-    }
+    if (temporal < object.cost) return build_children({ids, t0, tm}, {ids, tm, t1}, n, depth + 1, pair);
     std::vector<uint32_t> left, right;
     partition(items, object, left, right);
     items.clear();
-    build_node(left, t0, t1, depth + 1, pair);
-    build_node(right, t0, t1, depth + 1, pair + 1);
+    build_children({left, t0, t1}, {right, t0, t1}, n, depth + 1, pair);
+  }
+
+  /// What a child is built over: primitives and a time range.
+  struct ChildInput {
+    const std::vector<uint32_t>& ids;
+    float t0, t1;
+  };
+  /// The sibling pair at `pair` (children of a node of n primitives): in this tree, or for n at least
+  /// parallel_threshold in parallel, each into a tree of its own appended after (the same layout either way
+  /// for any number of threads).
+  void build_children(ChildInput l, ChildInput r, size_t n, int depth, uint32_t pair) {
+    if (n < settings_.parallel_threshold) {
+      build_node(l.ids, l.t0, l.t1, depth, pair);
+      build_node(r.ids, r.t0, r.t1, depth, pair + 1);
+      return;
+    }
+    MotionBvhBuild left, right;
+    tbb::parallel_invoke([&] { left = subtree(l, depth); }, [&] { right = subtree(r, depth); });
+    append(std::move(left), pair);
+    append(std::move(right), pair + 1);
+  }
+  /// A tree of its own over the child's input (its root at 0).
+  MotionBvhBuild subtree(ChildInput in, int depth) const {
+    MotionBvhBuilder sub(prims_, settings_);
+    sub.out_.nodes.resize(1);
+    sub.build_node(in.ids, in.t0, in.t1, depth, 0);
+    return std::move(sub.out_);
+  }
+  /// Places sub's root at `slot` and its other nodes and references at the ends of this tree's.
+  void append(MotionBvhBuild&& sub, uint32_t slot) {
+    const auto base = static_cast<uint32_t>(out_.nodes.size()) - 1;  // sub's node k >= 1 goes to base + k
+    const auto ref_base = static_cast<uint32_t>(out_.refs.size());
+    const auto moved = [&](MotionBvhNode node) {
+      node.offset += node.is_leaf() ? ref_base : base;
+      return node;
+    };
+    out_.nodes[slot] = moved(sub.nodes[0]);
+    for (size_t k = 1; k < sub.nodes.size(); ++k) out_.nodes.push_back(moved(sub.nodes[k]));
+    out_.refs.insert(out_.refs.end(), sub.refs.begin(), sub.refs.end());
   }
 
   void make_leaf(uint32_t index, const std::vector<uint32_t>& ids) {
@@ -164,11 +220,22 @@ class MotionBvhBuilder {
       tm = std::floor(t0 * segments + 1.0f) / segments;
       if (!(tm > t0 && tm < t1)) return kInf;
     }
+    // Both halves' bounds, by chunks of 1024 (in parallel for large nodes; a union of boxes is exact, so
+    // the result does not depend on the order).
+    const size_t chunks = (ids.size() + 1023) / 1024;
+    std::vector<LinearBounds> lefts(chunks, LinearBounds{AABB{}, AABB{}}), rights = lefts;
+    const auto chunk = [&](size_t c) {
+      for (size_t k = c * 1024, e = std::min(ids.size(), k + 1024); k < e; ++k) {
+        lefts[c].extend(prim_linear_bounds(prims_, ids[k], t0, tm));
+        rights[c].extend(prim_linear_bounds(prims_, ids[k], tm, t1));
+      }
+    };
+    if (ids.size() >= settings_.parallel_threshold)
+      tbb::parallel_for(size_t(0), chunks, chunk);
+    else
+      for (size_t c = 0; c < chunks; ++c) chunk(c);
     LinearBounds left{AABB{}, AABB{}}, right{AABB{}, AABB{}};
-    for (uint32_t id : ids) {
-      left.extend(prim_linear_bounds(prims_, id, t0, tm));
-      right.extend(prim_linear_bounds(prims_, id, tm, t1));
-    }
+    for (size_t c = 0; c < chunks; ++c) left.extend(lefts[c]), right.extend(rights[c]);
     const float wl = (tm - t0) / (t1 - t0), wr = 1.0f - wl;
     return settings_.costs.split(area, wl * left.middle().area(), ids.size(), wr * right.middle().area(),
                                  ids.size());

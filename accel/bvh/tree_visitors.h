@@ -39,25 +39,29 @@ using BvhTreeVisitor = BinaryTreeVisitor<BvhNodeArray, &BvhNode::box>;
 /// True when lane k of a wide node holds a child: a leaf (count > 0) or a node (index > 0, as the root is
 /// no one's child). Unlike Bvh8Node::used() this does not look at the box, which is empty for a subtree of
 /// primitives without bounds (instances of an empty mesh).
-inline bool holds_child(const Bvh8Node& node, int k) {
+template <class WideNode>
+bool holds_child(const WideNode& node, int k) {
   return node.count[k] > 0 || node.child[k] != 0;
 }
 
-/// The 8-wide BVH (not empty): a node is a lane's (child, count) with the lane's box, the root the wide
-/// root node with the union of its lanes' boxes (the binary root's box).
-struct Bvh8TreeVisitor {
+/// An 8-wide tree over node array Array (not empty; lanes with child, count and box(k)): a node is a lane's
+/// (child, count) with the lane's box, the root the wide root node with the union of its lanes' boxes (the
+/// binary root's box).
+template <class Array>
+struct WideTreeVisitor {
+  using WideNode = typename Array::value_type;  ///< the node type
   /// A wide node (count 0: index child) or a leaf (primitives [child, child + count)), with its box.
   struct Node {
     uint32_t child;  ///< wide node index (count 0) or first primitive (or block) of a leaf
     uint32_t count;  ///< primitives of a leaf, 0 for a wide node
     AABB box;        ///< the lane's box (the union of the root's lanes for the root)
   };
-  const Bvh8NodeArray& nodes;  ///< the tree
+  const Array& nodes;  ///< the tree
 
   /// The wide root node.
   Node root() const {
     AABB box;
-    for (int k = 0; k < Bvh8Node::kWidth; ++k)
+    for (int k = 0; k < WideNode::kWidth; ++k)
       if (holds_child(nodes[0], k)) box.extend(nodes[0].box(k));
     return {0, 0, box};
   }
@@ -70,11 +74,14 @@ struct Bvh8TreeVisitor {
   /// The used lanes of a wide node, last first: the walk pops the last child first, so it goes in lane order.
   template <class F>
   void children(const Node& n, F&& f) const {
-    const Bvh8Node& node = nodes[n.child];
-    for (int k = Bvh8Node::kWidth - 1; k >= 0; --k)
+    const WideNode& node = nodes[n.child];
+    for (int k = WideNode::kWidth - 1; k >= 0; --k)
       if (holds_child(node, k)) f(Node{node.child[k], node.count[k], node.box(k)});
   }
 };
+
+/// The 8-wide BVH.
+using Bvh8TreeVisitor = WideTreeVisitor<Bvh8NodeArray>;
 
 /// Mean number of children per node of an 8-wide BVH (not empty).
 inline double mean_children(const Bvh8NodeArray& nodes) {

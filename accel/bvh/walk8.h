@@ -53,34 +53,44 @@ struct Bvh8RayTest {
   /// Entry distances into t[0..7]; returns the mask of lanes entered.
   [[gnu::always_inline]] unsigned entries(const Bvh8Node& n, float limit, float* t) const {
 #if defined(__AVX2__)
-    const __m256 t0 = folded ? folded_near(n) : general_near(n);
-    const __m256 t1 = folded ? folded_far(n, limit) : general_far(n, limit);
-    _mm256_store_ps(t, t0);
-    return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    return entries_of_rows([&](int row) { return _mm256_load_ps(n.bounds[row]); }, limit, t);
 #else
     return entries_scalar(n, limit, t);
 #endif
   }
 
 #if defined(__AVX2__)
+  /// The same for boxes given as rows (`n(row)`: eight lanes of bounds row lo x, y, z, hi x, y, z), such as
+  /// boxes a motion node interpolates at the ray's time (motion_node8.h).
+  template <class Rows>
+  [[gnu::always_inline]] unsigned entries_of_rows(const Rows& n, float limit, float* t) const {
+    const __m256 t0 = folded ? folded_near(n) : general_near(n);
+    const __m256 t1 = folded ? folded_far(n, limit) : general_far(n, limit);
+    _mm256_store_ps(t, t0);
+    return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+  }
   /// (plane - org) * reciprocal on axis a of bounds row `row` (eight lanes).
-  [[gnu::always_inline]] static __m256 slab(const Bvh8Node& n, int row, __m256 o, __m256 r) {
-    return _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[row]), o), r);
+  template <class Rows>
+  [[gnu::always_inline]] static __m256 slab(const Rows& n, int row, __m256 o, __m256 r) {
+    return _mm256_mul_ps(_mm256_sub_ps(n(row), o), r);
   }
   /// Folded path: max(near_x, near_y, near_z, tmin), each max keeping the bound on NaN.
-  [[gnu::always_inline]] __m256 folded_near(const Bvh8Node& n) const {
+  template <class Rows>
+  [[gnu::always_inline]] __m256 folded_near(const Rows& n) const {
     __m256 t0 = _mm256_max_ps(slab(n, near_row[2], org[2], inv_near[2]), tmin8);
     t0 = _mm256_max_ps(slab(n, near_row[1], org[1], inv_near[1]), t0);
     return _mm256_max_ps(slab(n, near_row[0], org[0], inv_near[0]), t0);
   }
   /// Folded path: min(far_x, far_y, far_z, limit), each min keeping the bound on NaN.
-  [[gnu::always_inline]] __m256 folded_far(const Bvh8Node& n, float limit) const {
+  template <class Rows>
+  [[gnu::always_inline]] __m256 folded_far(const Rows& n, float limit) const {
     __m256 t1 = _mm256_min_ps(slab(n, far_row[2], org[2], inv_far[2]), _mm256_set1_ps(limit));
     t1 = _mm256_min_ps(slab(n, far_row[1], org[1], inv_far[1]), t1);
     return _mm256_min_ps(slab(n, far_row[0], org[0], inv_far[0]), t1);
   }
   /// General path (any tmin): the widened near distance clipped to tmin.
-  [[gnu::always_inline]] __m256 general_near(const Bvh8Node& n) const {
+  template <class Rows>
+  [[gnu::always_inline]] __m256 general_near(const Rows& n) const {
     __m256 tn = _mm256_set1_ps(-kInf);
     for (int a = 0; a < 3; ++a) tn = _mm256_max_ps(slab(n, near_row[a], org[a], inv[a]), tn);
     const __m256 shrink = _mm256_set1_ps(1.0f - kBoxEps), grow = _mm256_set1_ps(1.0f + kBoxEps);
@@ -89,7 +99,8 @@ struct Bvh8RayTest {
     return _mm256_max_ps(tn, tmin8);
   }
   /// General path: the widened far distance clipped to limit.
-  [[gnu::always_inline]] __m256 general_far(const Bvh8Node& n, float limit) const {
+  template <class Rows>
+  [[gnu::always_inline]] __m256 general_far(const Rows& n, float limit) const {
     __m256 tf = _mm256_set1_ps(kInf);
     for (int a = 0; a < 3; ++a) tf = _mm256_min_ps(slab(n, far_row[a], org[a], inv[a]), tf);
     const __m256 shrink = _mm256_set1_ps(1.0f - kBoxEps), grow = _mm256_set1_ps(1.0f + kBoxEps);
@@ -145,10 +156,23 @@ struct Bvh8RayTest {
 [[gnu::always_inline]] inline void prefetch_bytes(const char* p, size_t bytes) {
   for (size_t line = 0; line < bytes; line += 64) __builtin_prefetch(p + line);
 }
-/// Prefetches a whole node (four lines).
-[[gnu::always_inline]] inline void prefetch_node(const Bvh8Node* n) {
-  prefetch_bytes(reinterpret_cast<const char*>(n), sizeof(Bvh8Node));
+/// Prefetches a whole node (four lines for Bvh8Node).
+template <class Node>
+[[gnu::always_inline]] inline void prefetch_node(const Node* n) {
+  prefetch_bytes(reinterpret_cast<const char*>(n), sizeof(Node));
 }
+
+/// The ray test of an 8-wide node type: Bvh8RayTest for the box nodes; a node of another bound names its own
+/// (`using RayTest = ...;`, as the motion BVH's MotionBvh8Node does), with entries(node, limit, t).
+template <class Node>
+struct Bvh8RayTestOf {
+  using type = typename Node::RayTest;  ///< the node's own test
+};
+/// The box nodes' test.
+template <>
+struct Bvh8RayTestOf<Bvh8Node> {
+  using type = Bvh8RayTest;  ///< the slab test of eight boxes
+};
 
 /// A child waiting on the 8-wide walk's stack: a node (count 0) or a leaf's range, and the distance at
 /// which the ray enters its box.
@@ -164,7 +188,8 @@ struct Bvh8StackEntry {
 using Bvh8Stack = TraversalStack<Bvh8StackEntry, 7 * kBvhMaxDepth + 8>;
 
 /// Prefetches what entry e refers to: a node, or its leaf's data when leaf_data is not null.
-[[gnu::always_inline]] inline void prefetch_entry(const Bvh8Node* nodes, const Bvh8StackEntry& e,
+template <class Node>
+[[gnu::always_inline]] inline void prefetch_entry(const Node* nodes, const Bvh8StackEntry& e,
                                                   const char* leaf_data, size_t leaf_stride) {
   if (e.count == 0) {
     prefetch_node(nodes + e.child);
@@ -179,7 +204,8 @@ using Bvh8Stack = TraversalStack<Bvh8StackEntry, 7 * kBvhMaxDepth + 8>;
 /// as integers), and a lane's place is the number of entered lanes whose key is greater, found with one
 /// eight-lane compare. Distances that tie or are negative (tmin < 0) may come in another order; any order
 /// gives the same hits. Returns the number of lanes placed.
-[[gnu::always_inline]] inline int rank_entered_children(const Bvh8Node& n, unsigned mask, const float* t,
+template <class Node>
+[[gnu::always_inline]] inline int rank_entered_children(const Node& n, unsigned mask, const float* t,
                                                         Bvh8StackEntry* items) {
 #if defined(__AVX2__)
   const __m256i keys = _mm256_or_si256(
@@ -210,8 +236,8 @@ using Bvh8Stack = TraversalStack<Bvh8StackEntry, 7 * kBvhMaxDepth + 8>;
 /// next: sorted by entry distance, farthest stacked first (kSorted), or in lane order with the last lane
 /// next. Stacked nodes and leaf data (`leaf_data` + child * `leaf_stride` bytes, when not null) are
 /// prefetched.
-template <bool kSorted>
-[[gnu::always_inline]] inline Bvh8StackEntry stack_entered_children(const Bvh8Node* nodes, const Bvh8Node& n,
+template <bool kSorted, class Node>
+[[gnu::always_inline]] inline Bvh8StackEntry stack_entered_children(const Node* nodes, const Node& n,
                                                                     unsigned mask, const float* t,
                                                                     Bvh8Stack& stack, const char* leaf_data,
                                                                     size_t leaf_stride) {
@@ -232,22 +258,23 @@ template <bool kSorted>
   return items[m - 1];
 }
 
-/// Front-to-back walk of an 8-wide BVH (not empty). `limit()` is the current upper bound of the box tests
+/// Front-to-back walk of an 8-wide BVH (not empty; Bvh8Node, or a node of another bound with child[8],
+/// count[8] and its Bvh8RayTestOf). `limit()` is the current upper bound of the box tests
 /// (min(tmax, best.t) for closest hit, tmax for any hit); `leaf(first, count)` tests a leaf and returns true
 /// to end the walk. Entered children are visited nearest first (kSorted) or in lane order; a stacked child
 /// is skipped only when its entry lies strictly beyond limit(). Nodes and leaf data (`leaf_data` + first *
 /// `leaf_stride` bytes, when not null) are prefetched as soon as they are known to be entered. Returns true
 /// when a leaf ended the walk.
-template <bool kCount, bool kSorted, class Limit, class Leaf>
-[[gnu::always_inline]] inline bool walk_bvh8(const Bvh8Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
+template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
+[[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
                                              const char* leaf_data, size_t leaf_stride, RayCounters& c) {
-  const Bvh8RayTest test(ray);
+  const typename Bvh8RayTestOf<Node>::type test(ray);
   Bvh8Stack stack;
   Bvh8StackEntry cur{0, 0, ray.tmin};
   for (;;) {
     if constexpr (kCount) ++c.nodes;
     if (cur.count == 0) {
-      const Bvh8Node& n = nodes[cur.child];
+      const Node& n = nodes[cur.child];
       alignas(32) float t[8];
       const unsigned mask = test.entries(n, limit(), t);
       if (mask != 0) {
