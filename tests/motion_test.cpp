@@ -414,7 +414,7 @@ TEST(MotionBvh, TheWideNodeEntersALaneOnlyAtTimesInItsRange) {
 /// margin (kMotionBoxEps) keeps them from culling the hit.
 TEST(MotionBvh, RaysOnAMovingEdgeAreNotCulledByRounding) {
   std::vector<std::shared_ptr<const Mesh>> steps;
-  for (const float y : {1000.0f, 1003.3f, 999.1f}) {
+  for (const float y : {1000.0f, 1003.3f}) {  // linear motion: the linear bounds are exact
     Mesh m;
     for (uint32_t i = 0; i < 64; ++i) {
       const float x = 1000.0f + float(i % 8), z = 1000.0f + float(i / 8);
