@@ -82,7 +82,7 @@ int run_verify(const VerifyArgs& a) {
     rays = read_rays(a.rays);
   else
     rays = make_target_rays(target, a.kind.empty() ? "incoherent" : a.kind, a.count, a.seed);
-  const HitTriangleFn triangle_of = hit_triangles(target);
+  const HitTriangleAtFn triangle_of = hit_triangles(target);
   double embree_build = 0.0;
   const std::vector<Hit> embree = trace_with(target, kEmbreeName, rays, a.threads, embree_build);
   std::vector<Hit> brute;

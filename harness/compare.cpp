@@ -41,11 +41,11 @@ float coordinate_scale(const Ray& ray, const Triangle& tri) {
 /// True when the hit lies within 1e-4 (barycentric) of an edge, or within 1e-5 of the coordinates' scale
 /// (in distance) of one: on a sliver a barycentric coordinate is the distance to the long edge divided by
 /// a tiny height, so float rounding of about 1e-7 of the scale moves it by far more than 1e-4.
-bool near_edge(const Ray& ray, const Hit& h, const HitTriangleFn& triangle_of) {
+bool near_edge(const Ray& ray, const Hit& h, const HitTriangleAtFn& triangle_of) {
   if (!h.found()) return false;
   const float w = 1.0f - h.u - h.v;
   if (h.u <= kEdgeTolerance || h.v <= kEdgeTolerance || w <= kEdgeTolerance) return true;
-  const Triangle tri = triangle_of(h);
+  const Triangle tri = triangle_of(h, ray.time);
   const float twice_area = glm::length(glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
   const float opposite[3] = {glm::length(tri.v2 - tri.v1), glm::length(tri.v0 - tri.v2),
                              glm::length(tri.v1 - tri.v0)};
@@ -59,9 +59,9 @@ bool near_edge(const Ray& ray, const Hit& h, const HitTriangleFn& triangle_of) {
 /// True when the ray meets the hit's triangle at a grazing angle (cosine below 1e-3), or so flat that the
 /// one kernel calls it parallel (its rounding bound on the denominator: on slivers that reaches cosines of
 /// a few 1e-2, where Embree's kernel still reports a hit).
-bool grazing(const Ray& ray, const Hit& h, const HitTriangleFn& triangle_of) {
+bool grazing(const Ray& ray, const Hit& h, const HitTriangleAtFn& triangle_of) {
   if (!h.found()) return false;
-  const Triangle tri = triangle_of(h);
+  const Triangle tri = triangle_of(h, ray.time);
   const vec3 n = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
   const float ln = glm::length(n) * glm::length(ray.dir);
   return ln == 0.0f || std::fabs(glm::dot(n, ray.dir)) / ln < kGrazeCosine || kernel_calls_parallel(ray, tri);
@@ -74,7 +74,7 @@ bool near_limit(const Ray& ray, const Hit& h) {
 }  // namespace
 
 Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours,
-                             std::span<const Hit> theirs, const HitTriangleFn& triangle_of) {
+                             std::span<const Hit> theirs, const HitTriangleAtFn& triangle_of) {
   Agreement a;
   for (size_t i = 0; i < rays.size(); ++i) {
     const Hit& x = ours[i];
@@ -114,6 +114,12 @@ nlohmann::json to_json(const Agreement& a) {
           {"limit", a.limit},
           {"unexplained", a.unexplained},
           {"unexplained_rays", a.unexplained_rays}};
+}
+
+Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours,
+                             std::span<const Hit> theirs, const HitTriangleFn& triangle_of) {
+  return classify_agreement(rays, ours, theirs,
+                            HitTriangleAtFn([&](const Hit& h, float) { return triangle_of(h); }));
 }
 
 }  // namespace ab

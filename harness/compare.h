@@ -41,8 +41,14 @@ struct Agreement {
 
 /// World-space triangle of a hit (mesh: triangle prim; scene: the instance's transformed triangle).
 using HitTriangleFn = std::function<Triangle(const Hit&)>;
+/// World-space triangle of a hit at a ray's time (a deforming mesh's triangle and a moving instance's
+/// transform at that time, as every structure sees them).
+using HitTriangleAtFn = std::function<Triangle(const Hit&, float time)>;
 
-/// Classifies each ray's pair of hits (ours, embree's).
+/// Classifies each ray's pair of hits (ours, embree's), with each hit's triangle at its ray's time.
+Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours,
+                             std::span<const Hit> theirs, const HitTriangleAtFn& triangle_at);
+/// The same for triangles that do not move.
 Agreement classify_agreement(std::span<const Ray> rays, std::span<const Hit> ours,
                              std::span<const Hit> theirs, const HitTriangleFn& triangle_of);
 

@@ -1,11 +1,13 @@
 #include "harness/target.h"
 
 #include "accel/core/error.h"
+#include "accel/core/motion.h"
 #include "accel/core/registry.h"
 #include "datasets/mesh_io.h"
 #include "harness/selection.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"
+#include "tracer/scene_motion.h"
 #include "tracer/workload.h"
 
 namespace ab {
@@ -88,17 +90,29 @@ std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, con
   return make_rays(kind, rt, count, seed, views);
 }
 
-HitTriangleFn hit_triangles(const Target& target) {
+HitTriangleAtFn hit_triangles(const Target& target) {
   if (target.scene) {
     const std::shared_ptr<const Scene> scene = target.scene;
-    return [scene](const Hit& h) {
+    auto motion = std::make_shared<const SceneMotion>(scene_motion(*scene));  // nothing when still
+    return [scene, motion](const Hit& h, float time) {
       const SceneInstance& inst = scene->instances.at(h.inst);
-      const Triangle t = scene->meshes[inst.mesh].mesh->triangle(h.prim);
+      Triangle t = scene->meshes[inst.mesh].mesh->triangle(h.prim);
+      const auto& steps = motion->meshes[inst.mesh];
+      if (!steps.empty()) {  // the one triangle interpolation (MotionTrianglePrims::triangle_at)
+        const MotionSegment seg = motion_segment(time, static_cast<uint32_t>(steps.size()));
+        t = lerp_triangle(steps[seg.index]->triangle(h.prim), steps[seg.index + 1]->triangle(h.prim),
+                          seg.fraction);
+      }
+      if (h.inst < motion->instances.size() && !motion->instances[h.inst].empty()) {
+        const glm::mat4 m = matrix_at(motion->instances[h.inst], time);  // as instance_to_world_at
+        const auto point = [&](const vec3& p) { return vec3(m * glm::vec4(p, 1.0f)); };
+        return Triangle{point(t.v0), point(t.v1), point(t.v2)};
+      }
       return Triangle{inst.transform.point(t.v0), inst.transform.point(t.v1), inst.transform.point(t.v2)};
     };
   }
   const std::shared_ptr<const Mesh> mesh = target.mesh;
-  return [mesh](const Hit& h) { return mesh->triangle(h.prim); };
+  return [mesh](const Hit& h, float) { return mesh->triangle(h.prim); };
 }
 
 }  // namespace ab

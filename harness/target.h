@@ -52,6 +52,6 @@ std::vector<Ray> make_target_rays(const Target& target, const RayTarget& rt, con
 RayTarget ray_target(const Target& target);
 
 /// The world-space triangle of a hit on the target (used to explain disagreements with Embree).
-HitTriangleFn hit_triangles(const Target& target);
+HitTriangleAtFn hit_triangles(const Target& target);
 
 }  // namespace ab

@@ -20,6 +20,7 @@
 #include "datasets/random.h"
 #include "harness/compare.h"
 #include "harness/hitfile.h"
+#include "harness/target.h"
 #include "tracer/integrator.h"
 #include "tracer/scene.h"
 #include "tracer/scene_accel.h"
@@ -471,6 +472,31 @@ TEST(MotionBvh, BinaryWidthIsBruteAndTheParallelBuildIsTheSerialTree) {
   EXPECT_GT(serial.size(), 10 * sizeof(MotionBvh8Node));
   EXPECT_EQ(wide_tree(64, 1), serial);
   EXPECT_EQ(wide_tree(64, 2), serial);
+}
+
+TEST(MotionScene, VerifyExplainsHitsWithTheTrianglesAtTheRayTime) {
+  const auto scene = motion_scene();
+  auto brute = make_scene_accelerator(scene, "brute", Params{});
+  brute->build();
+  const std::vector<Ray> rays = scene_rays(*scene, brute->bounds(), *brute);
+  std::vector<Hit> hits(rays.size());
+  trace_closest(*brute, rays, hits, 2);
+  const HitTriangleAtFn triangle_at = hit_triangles(scene_target(scene, "motion.xml"));
+  size_t on_triangle = 0, off_at_time_zero = 0, found = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (!hits[i].found()) continue;
+    ++found;
+    const Hit& h = hits[i];
+    const vec3 p = rays[i].org + h.t * rays[i].dir;
+    const auto distance = [&](const Triangle& t) {
+      return glm::length((1.0f - h.u - h.v) * t.v0 + h.u * t.v1 + h.v * t.v2 - p);
+    };
+    on_triangle += distance(triangle_at(h, rays[i].time)) < 1e-3f;
+    off_at_time_zero += distance(triangle_at(h, 0.0f)) > 1e-2f;
+  }
+  EXPECT_GT(found, rays.size() / 4);
+  EXPECT_EQ(on_triangle, found);     // the hit point is on its triangle at the ray's time
+  EXPECT_GT(off_at_time_zero, 20u);  // and, for moving parts, not on the one at the frame's time
 }
 
 INSTANTIATE_TEST_SUITE_P(Structures, MotionConformance, ::testing::ValuesIn(structure_names()),
