@@ -26,7 +26,7 @@ struct MotionBvh8RayTest;
 /// box (lo +inf, hi -inf, no motion).
 struct alignas(64) MotionBvh8Node {
   static constexpr int kWidth = 8;    ///< children per node
-  using RayTest = MotionBvh8RayTest;  ///< the ray test of the eight lanes, for walk_bvh8
+  using RayTest = MotionBvh8RayTest;  ///< the ray test of the eight lanes, for walk_bvh8 (walk8.h)
 
   float start[6][kWidth];     ///< box rows at the start of each lane's range
   float motion[6][kWidth];    ///< the rows' motion from the start to the end of the range

@@ -11,12 +11,15 @@
 
 namespace ab {
 
+struct Bvh8RayTest;
+
 /// One node of the 8-wide BVH: the children's boxes as structure-of-arrays rows (lo x, y, z, then hi x,
 /// y, z; eight lanes each) and per child either a node index (count 0) or a leaf's range [child, child +
 /// count) of the leaf-ordered primitives. Unused lanes hold an empty box (lo +inf, hi -inf), which no ray
 /// enters. 256 bytes: four cache lines.
 struct alignas(64) Bvh8Node {
   static constexpr int kWidth = 8;  ///< children per node
+  using RayTest = Bvh8RayTest;      ///< the ray test of the eight boxes, for walk_bvh8 (walk8.h)
   float bounds[6][kWidth];          ///< lo x, y, z and hi x, y, z rows
   uint32_t child[kWidth];           ///< child node index (count 0) or first primitive (or block) of a leaf
   uint32_t count[kWidth];           ///< primitives of a leaf lane, 0 for a node (or an unused lane)

@@ -162,18 +162,6 @@ template <class Node>
   prefetch_bytes(reinterpret_cast<const char*>(n), sizeof(Node));
 }
 
-/// The ray test of an 8-wide node type: Bvh8RayTest for the box nodes; a node of another bound names its own
-/// (`using RayTest = ...;`, as the motion BVH's MotionBvh8Node does), with entries(node, limit, t).
-template <class Node>
-struct Bvh8RayTestOf {
-  using type = typename Node::RayTest;  ///< the node's own test
-};
-/// The box nodes' test.
-template <>
-struct Bvh8RayTestOf<Bvh8Node> {
-  using type = Bvh8RayTest;  ///< the slab test of eight boxes
-};
-
 /// A child waiting on the 8-wide walk's stack: a node (count 0) or a leaf's range, and the distance at
 /// which the ray enters its box.
 struct Bvh8StackEntry {
@@ -259,16 +247,16 @@ template <bool kSorted, class Node>
 }
 
 /// Front-to-back walk of an 8-wide BVH (not empty; Bvh8Node, or a node of another bound with child[8],
-/// count[8] and its Bvh8RayTestOf). `limit()` is the current upper bound of the box tests
-/// (min(tmax, best.t) for closest hit, tmax for any hit); `leaf(first, count)` tests a leaf and returns true
-/// to end the walk. Entered children are visited nearest first (kSorted) or in lane order; a stacked child
-/// is skipped only when its entry lies strictly beyond limit(). Nodes and leaf data (`leaf_data` + first *
-/// `leaf_stride` bytes, when not null) are prefetched as soon as they are known to be entered. Returns true
-/// when a leaf ended the walk.
+/// count[8] and the test it names, `using RayTest = ...;` with entries(node, limit, t)). `limit()` is the
+/// current upper bound of the box tests (min(tmax, best.t) for closest hit, tmax for any hit); `leaf(first,
+/// count)` tests a leaf and returns true to end the walk. Entered children are visited nearest first
+/// (kSorted) or in lane order; a stacked child is skipped only when its entry lies strictly beyond limit().
+/// Nodes and leaf data (`leaf_data` + first * `leaf_stride` bytes, when not null) are prefetched as soon as
+/// they are known to be entered. Returns true when a leaf ended the walk.
 template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
 [[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
                                              const char* leaf_data, size_t leaf_stride, RayCounters& c) {
-  const typename Bvh8RayTestOf<Node>::type test(ray);
+  const typename Node::RayTest test(ray);
   Bvh8Stack stack;
   Bvh8StackEntry cur{0, 0, ray.tmin};
   for (;;) {
