@@ -150,6 +150,17 @@ TEST(Bsp, UsesObliquePlanesAndTestsFewerTrianglesThanKdTreeOnSlantedSlivers) {
   EXPECT_LT(cb.prims, ck.prims);
 }
 
+TEST(Bsp, NodesAboveObliqueMaxTryOnlyTheAxes) {
+  // oblique_max=1: every node that can split is above it, so the tree is a k-d tree of boxes.
+  const Mesh mesh = oblique_slivers(40, 9);
+  const auto axes = built("bsp", mesh, {{"oblique_max", "1"}});
+  EXPECT_EQ(axes->stats().extra.at("oblique_planes").get<size_t>(), 0u);
+  EXPECT_GT(axes->stats().extra.at("axis_aligned_planes").get<size_t>(), 0u);
+  EXPECT_GT(built("bsp", mesh, {{"oblique_max", "0"}})->stats().extra.at("oblique_planes").get<size_t>(), 0u);
+  const std::vector<Ray> rays = adversarial_rays(mesh, 1500, 10);
+  EXPECT_EQ(count_differences("bsp", mesh, rays, {{"oblique_max", "1"}}), 0u);
+}
+
 TEST(Bsp, StatisticsAndThreadIndependence) {
   const Mesh mesh = random_soup(20000, 13, 0.02f);
   const std::vector<Ray> rays = adversarial_rays(mesh, 1500, 8);

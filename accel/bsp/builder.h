@@ -256,15 +256,37 @@ class BspBuilder {
     if (nl < n && nr < n && c < ch.progress.cost) ch.progress = {plane, c};
   }
 
+  /// The node's best planes over its candidates (binned_planes per direction, autopartition_planes).
   Choices find_plane(const NodePrims& np, const ConvexCell& cell, bool shave_ok) const {
     Choices ch;
-    const CellSurface surface(cell);
+    // Buffers kept from node to node on each thread (no call below builds another node); a large node's
+    // are its own, so no thread keeps a large buffer after the build.
+    thread_local CellSurface surface;
+    thread_local PlaneScratch kept;
+    PlaneScratch own;
+    PlaneScratch& scratch = np.size() <= kKeptScratchMax ? kept : own;
+    surface.assign(cell);
     const float area = surface.area();
     if (!(area > 0.0f)) return ch;
     const CellArea cell_area{area, 1.0f / area};
-    PlaneScratch scratch;
-    for (const vec3& dir : bsp_directions())
-      binned_planes(np, surface, cell_area, dir, shave_ok, scratch, ch);
+    // Large nodes: the three axes only (binned), no diagonals and no autopartition, so such a node costs
+    // O(N) with the k-d tree's constant and, as every ancestor of a large node is larger, the cells above
+    // oblique_max stay boxes. The size switch is the binned-above / exact-below switch of the SAH k-d tree
+    // builds (Hunt, Mark and Stoll 2006; Popov, Guenther, Seidel and Slusallek 2006; discussed by Wald and
+    // Havran 2006) applied to the set of directions: a restricted BSP (Kammaje and Mora 2007; Budge et al.
+    // 2008) whose restriction is the three axes above the size and the 13 directions and the triangles'
+    // own planes (Ize, Wald and Parker 2008) below it.
+    const bool large = config_.oblique_max > 0 && np.size() > config_.oblique_max;
+    const auto& dirs = bsp_directions();
+    for (size_t i = 0; i < (large ? 3 : dirs.size()); ++i)
+      binned_planes(np, surface, cell_area, dirs[i], shave_ok, scratch, ch);
+    if (!large) autopartition_planes(np, surface, cell_area, shave_ok, ch);
+    return ch;
+  }
+
+  /// The supporting planes of up to `autopartition` of the node's triangles (Ize, Wald and Parker 2008).
+  void autopartition_planes(const NodePrims& np, const CellSurface& surface, const CellArea& cell_area,
+                            bool shave_ok, Choices& ch) const {
     const size_t k = std::min<size_t>(np.size(), size_t(config_.autopartition));
     for (size_t j = 0; j < k; ++j) {
       BspPlane own;
@@ -288,13 +310,12 @@ class BspBuilder {
         keep(ch, BspPlane{own.n, d[m]}, cost(cell_area, al[m], ar[m], nl[m], nr[m]), nl[m], nr[m], np.size(),
              shave_ok);
     }
-    return ch;
   }
 
   /// The buffers of binned_planes, kept over the 13 directions of a node.
   struct PlaneScratch {
     std::vector<float> lo, hi, d, al, ar;
-    std::vector<uint32_t> nl, nr;
+    std::vector<uint32_t> nl, nr, starts, ends;
   };
 
   /// Candidate planes of direction dir. A node of at most `bins` primitives tries the planes at the ends of
@@ -323,7 +344,7 @@ class BspBuilder {
     if (n <= size_t(config_.bins)) {
       exact_candidates(lo, hi, d, nl, nr);
     } else {
-      binned_candidates(lo, hi, range_lo, range_hi, d, nl, nr);
+      binned_candidates(lo, hi, range_lo, range_hi, s, d, nl, nr);
     }
     float cell_lo, cell_hi;
     surface.extent(dir, cell_lo, cell_hi);
@@ -359,11 +380,13 @@ class BspBuilder {
 
   /// The bin boundaries and the planes two margins outside the whole range, with binned counts.
   void binned_candidates(const std::vector<float>& lo, const std::vector<float>& hi, float range_lo,
-                         float range_hi, std::vector<float>& d, std::vector<uint32_t>& nl,
+                         float range_hi, PlaneScratch& s, std::vector<float>& d, std::vector<uint32_t>& nl,
                          std::vector<uint32_t>& nr) const {
     const size_t n = lo.size();
     const int bins = config_.bins;
-    std::vector<uint32_t> starts(bins, 0), ends(bins, 0);
+    std::vector<uint32_t>&starts = s.starts, &ends = s.ends;
+    starts.assign(size_t(bins), 0);
+    ends.assign(size_t(bins), 0);
     const float scale = float(bins) / (range_hi - range_lo);
     for (size_t i = 0; i < n; ++i) {
       ++starts[std::clamp(int((lo[i] - range_lo) * scale), 0, bins - 1)];
@@ -411,6 +434,8 @@ class BspBuilder {
     }
   }
 
+  /// Nodes of at most this many primitives use their thread's kept candidate buffers (find_plane).
+  static constexpr size_t kKeptScratchMax = 4096;
   /// Nodes at least this large build their children in parallel (BSP nodes are costly: split the work deep).
   static constexpr size_t kParallelMin = 256;
   const P& prims_;

@@ -178,7 +178,15 @@ class ConvexCell {
 class CellSurface {
  public:
   /// Fan-triangulates the faces of cell.
-  explicit CellSurface(const ConvexCell& cell) {
+  explicit CellSurface(const ConvexCell& cell) { assign(cell); }
+  /// An empty surface (assign gives it a cell).
+  CellSurface() = default;
+
+  /// Makes this the surface of cell, keeping the buffers (one per thread in the BSP build).
+  void assign(const ConvexCell& cell) {
+    tris_.clear();
+    total_ = 0.0f;
+    tol_ = 0.0f;
     for (const auto& f : cell.faces())
       for (size_t i = 2; i < f.size(); ++i) {
         const vec3 cr = glm::cross(f[i - 1] - f[0], f[i] - f[0]);
@@ -212,20 +220,29 @@ class CellSurface {
     float* cut = above;  // the cut face's area accumulates in above[] until the end
     std::fill(cut, cut + d.size(), 0.0f);
     float lowest = kInf, highest = -kInf;
-    for (const Tri& t : tris_) {
+    heights_.resize(tris_.size());
+    for (size_t i = 0; i < tris_.size(); ++i) {
+      const Tri& t = tris_[i];
       float h[3] = {glm::dot(n, t.a), glm::dot(n, t.b), glm::dot(n, t.c)};
       if (h[0] > h[1]) std::swap(h[0], h[1]);
       if (h[1] > h[2]) std::swap(h[1], h[2]);
       if (h[0] > h[1]) std::swap(h[0], h[1]);
       lowest = std::min(lowest, h[0]);
       highest = std::max(highest, h[2]);
-      const float w = glm::dot(n, t.normal);
-      for (size_t k = 0; k < d.size(); ++k) {
-        const float a = t.area * fraction_below(h, d[k]);
-        below[k] += a;
-        cut[k] -= w * a;
-      }
+      heights_[i] = {h[0],
+                     h[1],
+                     h[2],
+                     1.0f / ((h[1] - h[0]) * (h[2] - h[0])),
+                     1.0f / ((h[2] - h[0]) * (h[2] - h[1])),
+                     t.area,
+                     glm::dot(n, t.normal) * t.area};
     }
+    for (const Heights& t : heights_)
+      for (size_t k = 0; k < d.size(); ++k) {  // branch-free: vectorized over the planes
+        const float f = fraction_below(t, d[k]);
+        below[k] += t.area * f;
+        cut[k] -= t.weighted * f;
+      }
     for (size_t k = 0; k < d.size(); ++k) {
       if (!(d[k] >
             lowest + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as ConvexCell::part)
@@ -249,15 +266,23 @@ class CellSurface {
     vec3 normal;
   };
 
-  /// Fraction of a triangle's area with height below d, given its sorted vertex heights.
-  static float fraction_below(const float* h, float d) {
-    if (!(d > h[0])) return 0.0f;
-    if (!(d < h[2])) return 1.0f;
-    if (d < h[1]) return (d - h[0]) * (d - h[0]) / ((h[1] - h[0]) * (h[2] - h[0]));
-    return 1.0f - (h[2] - d) * (h[2] - d) / ((h[2] - h[0]) * (h[2] - h[1]));
+  /// A surface triangle seen along one direction: its sorted vertex heights h0 <= h1 <= h2, the
+  /// reciprocals of the two quadratics' denominators, its area and its area times dot(n, normal).
+  struct Heights {
+    float h0, h1, h2, inv_low, inv_high, area, weighted;
+  };
+
+  /// Fraction of a triangle's area with height below d, without branches (the reciprocal of a zero
+  /// denominator is only ever in a lane the selects discard).
+  static float fraction_below(const Heights& t, float d) {
+    const float lo = d - t.h0, hi = t.h2 - d;
+    float f = d < t.h1 ? lo * lo * t.inv_low : 1.0f - hi * hi * t.inv_high;
+    f = d > t.h0 ? f : 0.0f;
+    return d < t.h2 ? f : (d > t.h0 ? 1.0f : 0.0f);
   }
 
   std::vector<Tri> tris_;
+  mutable std::vector<Heights> heights_;  ///< areas()'s scratch, kept over the node's directions
   float total_ = 0.0f;
   float tol_ = 0.0f;  ///< rounding band of a vertex's distance from a plane (as ConvexCell::part)
 };

@@ -15,8 +15,11 @@ struct BspConfig {
   /// ray at about the same nodes); a small empty bonus, as 13 directions offer many corner cuts, each one
   /// more level.
   SahCosts costs{.traversal = 1.0f, .intersection = 1.8f, .empty_bonus = 0.05f};
-  int bins = 16;                               ///< plane positions per fixed direction: bins - 1
-  int autopartition = 8;                       ///< triangles whose supporting planes are tried per node
+  int bins = 16;          ///< plane positions per fixed direction: bins - 1
+  int autopartition = 8;  ///< triangles whose supporting planes are tried per node
+  /// Nodes of more primitives than this try only the three axes' binned planes (no diagonals, no
+  /// autopartition), so their cells stay boxes (BspBuilder::find_plane; 0: every node tries all).
+  size_t oblique_max = 1024;
   int max_depth = 0;                           ///< depth limit; 0: auto_depth_limit of the primitive count
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   double ref_budget =
@@ -36,6 +39,7 @@ struct BspConfig {
     params.read("empty_bonus", c.costs.empty_bonus, 0.0, 0.99);
     params.read("bins", c.bins, 2, 256);
     params.read("autopartition", c.autopartition, 0, 1024);
+    params.read("oblique_max", c.oblique_max, 0, size_t(1) << 30);
     params.read("max_depth", c.max_depth, 0, 100);
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
     params.read("ref_budget", c.ref_budget, 1.0, 1e6);

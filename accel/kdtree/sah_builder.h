@@ -339,8 +339,10 @@ class KdSahBuilder {
     }
   }
 
-  /// Nodes at least this large build their children in parallel.
-  static constexpr size_t kParallelMin = 16384;
+  /// Nodes at least this large build their children in parallel (each into its own buffer, appended in a
+  /// fixed order: the same tree for any thread count). 1024, not 16384: at 20k triangles 16384 left only
+  /// the root's two subtrees to the threads, and on unbalanced trees (a fan) one thread did most of it.
+  static constexpr size_t kParallelMin = 1024;
   const P& prims_;
   KdSahConfig config_;
   SahCosts costs_;
