@@ -149,7 +149,12 @@ class BspBuilder {
     if (n <= 1 || depth.splits >= depth_limit_ || depth.levels >= depth_limit_ + kEmptyCutLevels) return {};
     const bool shave_ok =
         config_.bad_refines == 0 || n <= kFreeShaveSize || depth.shaves + 1 < config_.bad_refines;
-    const Choices c = find_plane(np, cell, shave_ok);
+    Choices c = find_plane(np, cell, shave_ok, large_node(n));
+    // A large node whose axis planes neither beat the leaf nor make progress tries every direction and
+    // the autopartition after all: at a fan's centre (every triangle shares a vertex at the cell's
+    // corner) only a plane through that vertex at another angle separates them.
+    if (large_node(n) && !(c.best.cost < config_.costs.leaf(n)) && !(c.progress.cost < kInf))
+      c = find_plane(np, cell, shave_ok, false);
     if (c.best.cost < config_.costs.leaf(n)) return {c.best.plane, true, false};
     if (config_.max_leaf > 0 && n > config_.max_leaf && c.progress.cost < kInf)
       return {c.progress.plane, true, true};
@@ -256,8 +261,9 @@ class BspBuilder {
     if (nl < n && nr < n && c < ch.progress.cost) ch.progress = {plane, c};
   }
 
-  /// The node's best planes over its candidates (binned_planes per direction, autopartition_planes).
-  Choices find_plane(const NodePrims& np, const ConvexCell& cell, bool shave_ok) const {
+  /// The node's best planes over its candidates (binned_planes per direction, autopartition_planes);
+  /// `large`: the three axes only.
+  Choices find_plane(const NodePrims& np, const ConvexCell& cell, bool shave_ok, bool large) const {
     Choices ch;
     // Buffers kept from node to node on each thread (no call below builds another node); a large node's
     // are its own, so no thread keeps a large buffer after the build.
@@ -271,18 +277,20 @@ class BspBuilder {
     const CellArea cell_area{area, 1.0f / area};
     // Large nodes: the three axes only (binned), no diagonals and no autopartition, so such a node costs
     // O(N) with the k-d tree's constant and, as every ancestor of a large node is larger, the cells above
-    // oblique_max stay boxes. The size switch is the binned-above / exact-below switch of the SAH k-d tree
-    // builds (Hunt, Mark and Stoll 2006; Popov, Guenther, Seidel and Slusallek 2006; discussed by Wald and
-    // Havran 2006) applied to the set of directions: a restricted BSP (Kammaje and Mora 2007; Budge et al.
-    // 2008) whose restriction is the three axes above the size and the 13 directions and the triangles'
-    // own planes (Ize, Wald and Parker 2008) below it.
-    const bool large = config_.oblique_max > 0 && np.size() > config_.oblique_max;
+    // oblique_max stay boxes (unless the axes fail: decide). The size switch is the binned-above /
+    // exact-below switch of the SAH k-d tree builds (Hunt, Mark and Stoll 2006; Popov, Guenther, Seidel and
+    // Slusallek 2006; discussed by Wald and Havran 2006) applied to the set of directions: a restricted BSP
+    // (Kammaje and Mora 2007; Budge et al. 2008) whose restriction is the three axes above the size and the
+    // 13 directions and the triangles' own planes (Ize, Wald and Parker 2008) below it.
     const auto& dirs = bsp_directions();
     for (size_t i = 0; i < (large ? 3 : dirs.size()); ++i)
       binned_planes(np, surface, cell_area, dirs[i], shave_ok, scratch, ch);
     if (!large) autopartition_planes(np, surface, cell_area, shave_ok, ch);
     return ch;
   }
+
+  /// True for a node of more than oblique_max primitives: the three axes only (find_plane).
+  bool large_node(size_t n) const { return config_.oblique_max > 0 && n > config_.oblique_max; }
 
   /// The supporting planes of up to `autopartition` of the node's triangles (Ize, Wald and Parker 2008).
   void autopartition_planes(const NodePrims& np, const CellSurface& surface, const CellArea& cell_area,
@@ -342,10 +350,14 @@ class BspBuilder {
     }
     if (!(range_hi > range_lo)) return;
     if (n <= size_t(config_.bins)) {
-      exact_candidates(lo, hi, d, nl, nr);
+      exact_candidates(lo, hi, n, d, nl, nr);
     } else {
       binned_candidates(lo, hi, range_lo, range_hi, s, d, nl, nr);
     }
+    // A large node (axes only) also tries the extent planes of the triangles the autopartition would
+    // take: at a fan's centre every triangle ends at the shared vertex, and only a plane through it
+    // separates them (without it, 20k `fan`'s centre stayed one leaf of 20,000).
+    if (large_node(n)) exact_candidates(lo, hi, size_t(config_.autopartition), d, nl, nr);
     float cell_lo, cell_hi;
     surface.extent(dir, cell_lo, cell_hi);
     const float min_gap = (cell_hi - cell_lo) / float(config_.bins);
@@ -359,19 +371,23 @@ class BspBuilder {
     }
   }
 
-  /// Planes at each extent's start and end (that primitive on one side only), with exact counts.
-  void exact_candidates(const std::vector<float>& lo, const std::vector<float>& hi, std::vector<float>& d,
-                        std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
-    for (size_t k = 0; k < lo.size(); ++k) {
-      d.push_back(lo[k]);  // primitive k above only (side_bits)
-      d.push_back(hi[k]);  // primitive k below only
+  /// Planes at the start and end of the extents of `samples` primitives spread over the node (every one
+  /// when samples >= n; that primitive on one side only), appended with exact counts.
+  void exact_candidates(const std::vector<float>& lo, const std::vector<float>& hi, size_t samples,
+                        std::vector<float>& d, std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
+    const size_t n = lo.size(), k = std::min(n, samples), first = d.size();
+    for (size_t j = 0; j < k; ++j) {
+      d.push_back(lo[j * n / k]);  // primitive j above only (side_bits)
+      d.push_back(hi[j * n / k]);  // primitive j below only
     }
-    for (const float x : d) {
+    const float half = 0.5f * margin_;
+    for (size_t j = first; j < d.size(); ++j) {
+      const float x = d[j];
       uint32_t l = 0, r = 0;
-      for (size_t k = 0; k < lo.size(); ++k) {  // the classification of side()
-        const int bits = side_bits(lo[k] - x, hi[k] - x);
-        l += bits & 1;
-        r += bits >> 1;
+      for (size_t i = 0; i < n; ++i) {  // side_bits without branches (vectorized)
+        const bool below = hi[i] - x <= half, above = lo[i] - x >= -half;
+        l += uint32_t(below || !above);
+        r += uint32_t(!below);
       }
       nl.push_back(l);
       nr.push_back(r);

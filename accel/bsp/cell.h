@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <span>
 #include <vector>
@@ -216,11 +217,10 @@ class CellSurface {
   /// Areas of the parts below and above each plane dot(n, x) = d[k] (each including the cut face); a
   /// plane within rounding of the cell's extent along n does not cut it (one part gets zero area).
   void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
-    std::fill(below, below + d.size(), 0.0f);
-    float* cut = above;  // the cut face's area accumulates in above[] until the end
-    std::fill(cut, cut + d.size(), 0.0f);
+    float* cut = above;  // the cut face's area goes to above[] until the end
     float lowest = kInf, highest = -kInf;
-    heights_.resize(tris_.size());
+    const size_t chunks = (tris_.size() + kLanes - 1) / kLanes;
+    heights_.assign(chunks * kFields * kLanes, 0.0f);  // padding: zero area, so it adds nothing
     for (size_t i = 0; i < tris_.size(); ++i) {
       const Tri& t = tris_[i];
       float h[3] = {glm::dot(n, t.a), glm::dot(n, t.b), glm::dot(n, t.c)};
@@ -229,20 +229,17 @@ class CellSurface {
       if (h[0] > h[1]) std::swap(h[0], h[1]);
       lowest = std::min(lowest, h[0]);
       highest = std::max(highest, h[2]);
-      heights_[i] = {h[0],
-                     h[1],
-                     h[2],
-                     1.0f / ((h[1] - h[0]) * (h[2] - h[0])),
-                     1.0f / ((h[2] - h[0]) * (h[2] - h[1])),
-                     t.area,
-                     glm::dot(n, t.normal) * t.area};
+      const float fields[kFields] = {h[0],
+                                     h[1],
+                                     h[2],
+                                     1.0f / ((h[1] - h[0]) * (h[2] - h[0])),
+                                     1.0f / ((h[2] - h[0]) * (h[2] - h[1])),
+                                     t.area,
+                                     glm::dot(n, t.normal) * t.area};
+      float* chunk = &heights_[i / kLanes * kFields * kLanes + i % kLanes];
+      for (size_t f = 0; f < kFields; ++f) chunk[f * kLanes] = fields[f];
     }
-    for (const Heights& t : heights_)
-      for (size_t k = 0; k < d.size(); ++k) {  // branch-free: vectorized over the planes
-        const float f = fraction_below(t, d[k]);
-        below[k] += t.area * f;
-        cut[k] -= t.weighted * f;
-      }
+    for (size_t k = 0; k < d.size(); ++k) area_below(d[k], below[k], cut[k]);
     for (size_t k = 0; k < d.size(); ++k) {
       if (!(d[k] >
             lowest + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as ConvexCell::part)
@@ -266,23 +263,37 @@ class CellSurface {
     vec3 normal;
   };
 
-  /// A surface triangle seen along one direction: its sorted vertex heights h0 <= h1 <= h2, the
-  /// reciprocals of the two quadratics' denominators, its area and its area times dot(n, normal).
-  struct Heights {
-    float h0, h1, h2, inv_low, inv_high, area, weighted;
-  };
-
-  /// Fraction of a triangle's area with height below d, without branches (the reciprocal of a zero
-  /// denominator is only ever in a lane the selects discard).
-  static float fraction_below(const Heights& t, float d) {
-    const float lo = d - t.h0, hi = t.h2 - d;
-    float f = d < t.h1 ? lo * lo * t.inv_low : 1.0f - hi * hi * t.inv_high;
-    f = d > t.h0 ? f : 0.0f;
-    return d < t.h2 ? f : (d > t.h0 ? 1.0f : 0.0f);
+  /// Sums of the surface's area below d and of the cut face's share, over kLanes triangles at a time
+  /// (one accumulator per lane: the loop over the lanes is vectorized). The heights are kept by chunks of
+  /// kLanes triangles, field by field: h0, h1, h2 (sorted), the reciprocals of the two quadratics'
+  /// denominators, the area and the area times dot(n, normal).
+  void area_below(float d, float& below, float& cut) const {
+    std::array<float, kLanes> b{}, c{};
+    for (size_t i = 0; i < heights_.size(); i += kFields * kLanes) {
+      const float *h0 = &heights_[i], *h1 = h0 + kLanes, *h2 = h1 + kLanes, *il = h2 + kLanes;
+      const float *ih = il + kLanes, *area = ih + kLanes, *weighted = area + kLanes;
+      for (size_t l = 0; l < kLanes; ++l) {
+        // The fraction of the triangle's area below d, without branches (the reciprocal of a zero
+        // denominator is only ever in a lane the selects discard).
+        const float lo = d - h0[l], hi = h2[l] - d;
+        float f = d < h1[l] ? lo * lo * il[l] : 1.0f - hi * hi * ih[l];
+        f = d > h0[l] ? f : 0.0f;
+        f = d < h2[l] ? f : (d > h0[l] ? 1.0f : 0.0f);
+        b[l] += area[l] * f;
+        c[l] += weighted[l] * f;
+      }
+    }
+    below = 0.0f;
+    cut = 0.0f;
+    for (size_t l = 0; l < kLanes; ++l) {
+      below += b[l];
+      cut -= c[l];
+    }
   }
+  static constexpr size_t kLanes = 16, kFields = 7;
 
   std::vector<Tri> tris_;
-  mutable std::vector<Heights> heights_;  ///< areas()'s scratch, kept over the node's directions
+  mutable std::vector<float> heights_;  ///< areas()'s scratch (area_below), kept over the node's directions
   float total_ = 0.0f;
   float tol_ = 0.0f;  ///< rounding band of a vertex's distance from a plane (as ConvexCell::part)
 };

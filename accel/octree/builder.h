@@ -6,7 +6,8 @@
 //   estimated cost is not below the leaf's; with the surface-area estimate, each child cube has a quarter
 //   of its parent's area, so it is bad when the children hold at least 4x the node's references; the
 //   bad_refines-th bad one on a path makes a leaf instead (large overlapping triangles, copied into most
-//   children, stop after a few levels);
+//   children, stop after a few levels); a subdivision whose every non-empty child holds all the node's
+//   primitives is a bad one too (a fan's centre: the next level separates them);
 // - the reference budget (build_with_budget, refine_rules.h) as a safety net: at most ref_budget
 //   references per primitive, the tree unchanged on any input whose tree stays under it.
 // Primitives are inserted by exact primitive/box overlap against the child boxes grown by the insertion
@@ -91,7 +92,12 @@ class OctreeBuilder {
       progress |= !k.empty() && k.size() < n;
       refs += k.size();
     }
-    if (!progress || too_many_bad_refines(refs >= 4 * n, config_.bad_refines, path.bad)) return true;
+    // No progress (every non-empty child holds all n) is a bad refine too, not a leaf at once: at a fan's
+    // centre (the poles of a tessellated sphere, all triangles sharing one vertex on the children's common
+    // corner) every child holds all n, but a level further down only the cell at the vertex does, and
+    // that cell shrinks eightfold per level. (bad_refines=0: no progress stops, as the rule is off.)
+    if (refs == 0 || (!progress && config_.bad_refines == 0)) return true;  // refs 0: not distributed
+    if (too_many_bad_refines(!progress || refs >= 4 * n, config_.bad_refines, path.bad)) return true;
     return !path.budget.allows(refs);
   }
 
