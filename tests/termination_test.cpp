@@ -146,6 +146,17 @@ TEST(Termination, KdSahSplitsLargeOverlappingTriangles) {
   EXPECT_EQ(count_differences("kdtree-sah", mesh, adversarial_rays(mesh, 1500, 7)), 0u);
 }
 
+TEST(Termination, OctreeSubdividesFanCentres) {
+  // The poles of a tessellated sphere: every triangle around a pole shares its vertex, which lies on the
+  // children's common corner, so every child holds all of them (no progress); a level further down they
+  // part. A leaf at once left leaves of 129 triangles here (62,653 at 10M: 5,096 tests per ray).
+  const Mesh mesh = generate_mesh("sphereflake", 10000, 4, Params());
+  const BuildStats s = built("octree", mesh)->stats();
+  EXPECT_LT(s.leaf_size_histogram.rbegin()->first, 64u);
+  EXPECT_GT(built("octree", mesh, {{"bad_refines", "0"}})->stats().leaf_size_histogram.rbegin()->first, 64u);
+  EXPECT_EQ(count_differences("octree", mesh, adversarial_rays(mesh, 1000, 3)), 0u);
+}
+
 TEST(Termination, GridHalvesLambdaUntilTheReferencesFit) {
   const Mesh mesh = generate_mesh("large", 3000, 8, Params());
   const BuildStats s = built("grid", mesh, {{"ref_budget", "4"}})->stats();
