@@ -4,6 +4,7 @@
 // threads, adaptive rebuilds once its threshold is crossed, and Embree's dynamic commit agrees with brute.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <tbb/task_arena.h>
 
 #include <cstring>
 #include <filesystem>
@@ -133,11 +134,74 @@ TEST(Refit, EveryBuilderBothWidthsKeepsBoxesTightAndHitsIdentical) {
   }
 }
 
+/// True when the two arrays hold the same bytes.
+template <class A>
+bool same_bytes(const A& a, const A& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+}
+
+/// Refitting straight from the frame's mesh (at 1 thread) gives the tree a refit from its TrianglePrims (at
+/// 2) gives, byte for byte, tight, with brute's hits; after it a rebuild and the quality metrics see the
+/// frame (its TrianglePrims made then), and a mesh of another triangle count is refused.
+template <class B>
+void check_refit_from_mesh(int width) {
+  const Mesh base = generate_mesh("sphereflake", 3000, 1, {});
+  auto prims0 = std::make_shared<TrianglePrims>(std::make_shared<Mesh>(base));
+  typename B::Config config;
+  config.width = width;
+  B from_mesh(prims0, config), from_prims(prims0, config);
+  from_mesh.build(), from_prims.build();
+  // Refitted to the positions it was built over, the leaf blocks are the build's byte for byte (their terms,
+  // made four lanes at once, are the bits the build's packing stores lane by lane).
+  const std::vector<Triangle4> built_blocks = from_mesh.leaf_blocks();
+  ASSERT_TRUE(from_mesh.refit(std::make_shared<const Mesh>(base)));
+  EXPECT_TRUE(same_bytes(from_mesh.leaf_blocks(), built_blocks));
+  std::shared_ptr<const TrianglePrims> prims;
+  for (Deformer::Kind kind : {Deformer::Kind::kWave, Deformer::Kind::kExplode})
+    for (float p : {0.3f, 1.0f}) {
+      const auto mesh = deformed(base, kind, p);
+      prims = std::make_shared<TrianglePrims>(mesh);
+      bool ok_mesh = false, ok_prims = false;
+      tbb::task_arena(1).execute([&] { ok_mesh = from_mesh.refit(mesh); });
+      tbb::task_arena(2).execute([&] { ok_prims = from_prims.refit(prims); });
+      ASSERT_TRUE(ok_mesh && ok_prims);
+      ASSERT_TRUE(same_bytes(from_mesh.nodes(), from_prims.nodes()));
+      ASSERT_TRUE(same_bytes(from_mesh.wide_nodes(), from_prims.wide_nodes()));
+      if (width == 2) expect_tight_binary(from_mesh, *prims);
+      if (width == 8) expect_tight_wide(from_mesh, *prims);
+      EXPECT_EQ(from_mesh.bounds().lo, prims->bounds().lo);
+      EXPECT_EQ(from_mesh.bounds().hi, prims->bounds().hi);
+      auto brute = make_accelerator("brute", prims, {});
+      brute->build();
+      const std::vector<Ray> rays = rays_into(prims->bounds(), 1500);
+      const std::vector<Hit> expected = hits_of(*brute, rays, 1);
+      for (int threads : {1, 2})
+        EXPECT_TRUE(same_hits(hits_of(from_mesh, rays, threads), expected))
+            << "width " << width << " p " << p;
+    }
+  from_mesh.measure_quality(), from_prims.measure_quality();
+  EXPECT_EQ(from_mesh.stats().epo, from_prims.stats().epo);
+  from_mesh.build();  // over the last frame: its TrianglePrims is made from the mesh now
+  auto brute = make_accelerator("brute", prims, {});
+  brute->build();
+  const std::vector<Ray> rays = rays_into(prims->bounds(), 1500, 7);
+  EXPECT_TRUE(same_hits(hits_of(from_mesh, rays, 2), hits_of(*brute, rays, 1)));
+  EXPECT_FALSE(from_mesh.refit(std::make_shared<const Mesh>()));
+}
+
+TEST(Refit, FromTheMeshEqualsFromItsTrianglePrims) {
+  for (int width : {2, 8}) {
+    check_refit_from_mesh<BvhSah<TrianglePrims>>(width);
+    check_refit_from_mesh<BvhMedian<TrianglePrims>>(width);
+  }
+}
+
 TEST(Refit, StructuresThatDoNotRefitSayFalse) {
   auto prims = std::make_shared<TrianglePrims>(std::make_shared<Mesh>(generate_mesh("tetra", 64, 1, {})));
   auto grid = make_accelerator("grid", prims, {});
   grid->build();
   EXPECT_FALSE(grid->refit(prims));
+  EXPECT_FALSE(grid->refit(std::make_shared<const Mesh>(prims->mesh())));
   EXPECT_TRUE(FrameUpdater::supports("bvh-sah", {}, UpdateStrategy::kRefit));
   EXPECT_FALSE(FrameUpdater::supports("grid", {}, UpdateStrategy::kRefit));
   EXPECT_TRUE(FrameUpdater::supports("grid", {}, UpdateStrategy::kTopLevel));

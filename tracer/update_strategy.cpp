@@ -136,11 +136,12 @@ bool SceneAccelerator::update(std::shared_ptr<const Scene> frame, LevelUpdate bo
   for (size_t m = 0; m < bottoms_.size(); ++m) {
     if (frame->meshes[m].mesh == scene_->meshes[m].mesh) continue;  // the same geometry: kept
     if (frame->meshes[m].mesh->size() != scene_->meshes[m].mesh->size()) return false;
-    auto prims = std::make_shared<TrianglePrims>(frame->meshes[m].mesh);
     if (bottom == LevelUpdate::kRefit) {
-      if (!bottoms_[m]->refit(prims)) return false;
+      // From the frame's indexed mesh: the refit pays for everything the traversal needs (refit.h).
+      if (!bottoms_[m]->refit(frame->meshes[m].mesh)) return false;
     } else {
-      bottoms_[m] = make_accelerator(bottom_name_, std::move(prims), bottom_params_);
+      bottoms_[m] = make_accelerator(bottom_name_, std::make_shared<TrianglePrims>(frame->meshes[m].mesh),
+                                     bottom_params_);
       bottoms_[m]->build();
     }
   }

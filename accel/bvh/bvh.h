@@ -12,6 +12,7 @@
 #include <bit>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <type_traits>
 #include <vector>
 
@@ -48,14 +49,15 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   using Config = C;  ///< the Config, which also chooses the builder (build_bvh's overloads)
 
   /// Over prims with the given Config; the build is separate (build()).
-  Bvh(std::shared_ptr<const P> prims, const Config& config) : prims_(std::move(prims)), config_(config) {
+  Bvh(std::shared_ptr<const P> prims, const Config& config)
+      : prims_(std::move(prims)), config_(config), bounds_(prims_->bounds()) {
     // Wide leaves test triangles four at a time, so the SAH prices a leaf by its blocks of four.
     if constexpr (requires { config_.costs; })
       if (config_.width == 8 && kCopiesTriangles) config_.costs.block = 4;
   }
 
-  /// Bounds of every primitive.
-  AABB bounds() const override { return prims_->bounds(); }
+  /// Bounds of every primitive (at the last build or refit).
+  AABB bounds() const override { return bounds_; }
   /// The flattened binary nodes (empty for width 8, whose build frees them; for tests).
   const BvhNodeArray& nodes() const { return nodes_; }
   /// The 8-wide nodes (empty for width 2; for tests).
@@ -64,6 +66,8 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   const std::vector<uint32_t>& block_ids() const { return blocks_.ids; }
   /// Primitive ids in leaf order (for tests).
   const std::vector<uint32_t>& order() const { return order_; }
+  /// The wide leaves' triangle blocks (empty for width 2; for tests).
+  const std::vector<Triangle4>& leaf_blocks() const { return blocks_.blocks; }
 
   /// Closest hit: front to back, nearer child first; a child is skipped only when its entry distance is
   /// strictly greater than best.t (the box tests' upper bound is min(tmax, best.t)).
@@ -121,8 +125,13 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   bool do_refit_instances(std::shared_ptr<const InstancePrims> p) override {
     return BvhRefit<Bvh>::refit(*this, p);
   }
+  bool do_refit_mesh(std::shared_ptr<const Mesh> mesh) override {
+    if constexpr (kCopiesTriangles) return BvhRefit<Bvh>::refit_mesh(*this, std::move(mesh));
+    return false;
+  }
 
   void do_build() override {
+    bounds_ = current_prims().bounds();
     BvhBuildResult result = build_bvh_over_prims();
     nodes_ = std::move(result.nodes);
     order_ = std::move(result.order);
@@ -204,19 +213,20 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   /// End-point overlap (accel/common/epo.h) of the tree as traversed: the binary tree for width 2, the
   /// wide tree for width 8 (its leaves' triangles from the block lanes).
   double tree_epo() const {
-    const auto triangle = [&](size_t id) { return prims_->triangle(id); };
+    const P& prims = current_prims();
+    const auto triangle = [&](size_t id) { return prims.triangle(id); };
     if (!nodes_.empty()) {
       const auto leaf = [&](uint32_t i, auto&& f) {
         for (uint32_t k = nodes_[i].offset; k < nodes_[i].offset + nodes_[i].count; ++k) f(order_[k]);
       };
-      return end_point_overlap(BvhTreeVisitor{nodes_}, leaf, prims_->size(), triangle);
+      return end_point_overlap(BvhTreeVisitor{nodes_}, leaf, prims.size(), triangle);
     }
     if (wide_.empty()) return -1.0;
     const auto leaf = [&](const Bvh8TreeVisitor::Node& n, auto&& f) {
       for (uint32_t k = 4 * n.child; k < 4 * (n.child + (n.count + 3) / 4); ++k)
         if (blocks_.ids[k] != kInvalidId) f(blocks_.ids[k]);
     };
-    return end_point_overlap(Bvh8TreeVisitor{wide_}, leaf, prims_->size(), triangle);
+    return end_point_overlap(Bvh8TreeVisitor{wide_}, leaf, prims.size(), triangle);
   }
 
   /// The wide tree's triangle blocks as bytes for prefetching (null for other primitive sets).
@@ -281,8 +291,22 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     }
   }
 
-  std::shared_ptr<const P> prims_;
+  /// The primitive set of the current positions: after a refit from a frame's mesh (refit.h) its
+  /// TrianglePrims is made here, on first use (the traversal reads only the leaves' copies).
+  const P& current_prims() const {
+    if constexpr (kCopiesTriangles) {
+      const std::lock_guard<std::mutex> lock(frame_mutex_);
+      if (frame_mesh_) prims_ = std::make_shared<const P>(std::move(frame_mesh_));
+      frame_mesh_.reset();
+    }
+    return *prims_;
+  }
+
+  mutable std::shared_ptr<const P> prims_;  ///< the primitives (of an earlier frame while frame_mesh_)
+  mutable std::shared_ptr<const Mesh> frame_mesh_;  ///< the mesh of the last refit_mesh, until current_prims
+  mutable std::mutex frame_mutex_;                  ///< guards prims_ and frame_mesh_ in current_prims
   Config config_;
+  AABB bounds_;                  ///< bounds of every primitive (the last build's or refit's)
   BvhNodeArray nodes_;           ///< the binary tree (width 2)
   Bvh8NodeArray wide_;           ///< the 8-wide tree (width 8)
   BuildStats binary_;            ///< the binary tree's figures (width 8; taken before the collapse)

@@ -6,72 +6,158 @@
 
 namespace ab {
 
-void refit_binary_interiors(BvhNodeArray& nodes) {
-  for (size_t i = nodes.size(); i-- > 0;) {
-    BvhNode& n = nodes[i];
-    if (i == 1 || n.is_leaf()) continue;
-    const BvhNode& l = nodes[n.offset];
-    const BvhNode& r = nodes[n.offset + 1];
-    for (int a = 0; a < 3; ++a) {
-      n.lo[a] = std::min(l.lo[a], r.lo[a]);
-      n.hi[a] = std::max(l.hi[a], r.hi[a]);
-    }
-  }
+namespace {
+
+/// Prefetch distances in leaf-order lanes: the index triples (a mesh's) of the lanes kIndexAhead on and the
+/// corners of the lanes kCornerAhead on are fetched ahead of use, so the gathers' latency (the ids are in
+/// leaf order, the triangles in id order) is hidden behind the leaves written meanwhile.
+constexpr size_t kIndexAhead = 32, kCornerAhead = 16;
+
+/// Prefetches the cache lines of bytes [p, p + size).
+void prefetch_bytes(const void* p, size_t size) {
+  const char* c = static_cast<const char*>(p);
+  _mm_prefetch(c, _MM_HINT_T0);
+  if ((reinterpret_cast<uintptr_t>(c) & 63) + size > 64) _mm_prefetch(c + size - 1, _MM_HINT_T0);
 }
 
-void refit_wide_interiors(Bvh8NodeArray& wide) {
-  for (size_t i = wide.size(); i-- > 0;) {
-    Bvh8Node& node = wide[i];
-    for (int k = 0; k < Bvh8Node::kWidth; ++k) {
-      if (node.count[k] != 0 || node.child[k] == 0) continue;  // a leaf lane or an unused lane
-      const Bvh8Node& c = wide[node.child[k]];
-      // Unused lanes of c hold the empty box, which leaves the union unchanged.
-      for (int a = 0; a < 3; ++a) {
-        float lo = kInf, hi = -kInf;
-        for (int j = 0; j < Bvh8Node::kWidth; ++j) {
-          lo = std::min(lo, c.bounds[a][j]);
-          hi = std::max(hi, c.bounds[3 + a][j]);
-        }
-        node.bounds[a][k] = lo;
-        node.bounds[3 + a][k] = hi;
-      }
-    }
-  }
+/// Point p as four lanes (x, y, z, 0), read without touching the bytes after it.
+__m128 lanes_of(const vec3& p) {
+  return _mm_maskload_ps(&p.x, _mm_setr_epi32(-1, -1, -1, 0));
 }
 
-AABB refresh_leaf_triangles(Triangle* out, const uint32_t* ids, uint32_t count, const TrianglePrims& prims) {
-  AABB box;
-  for (uint32_t k = 0; k < count; ++k) {
-    out[k] = prims.triangle(ids[k]);
-    box.extend(out[k].bounds());
+/// The corners of triangle `id` of a TrianglePrims (its copy in id order).
+struct PrimsCorners {
+  const TrianglePrims& prims;
+  const Triangle& operator()(uint32_t id) const { return prims.triangle(id); }
+  /// The three corners of triangle id as four lanes each.
+  void lanes(uint32_t id, __m128* p) const {
+    const Triangle& t = prims.triangle(id);
+    p[0] = lanes_of(t.v0), p[1] = lanes_of(t.v1), p[2] = lanes_of(t.v2);
   }
-  return box;
-}
+  /// Prefetches what lane k's successors will read (ids: the n lanes' ids in leaf order).
+  void prefetch(const uint32_t* ids, size_t k, size_t n) const {
+    if (k + kCornerAhead >= n) return;
+    const uint32_t id = ids[k + kCornerAhead];
+    if (id != kInvalidId) prefetch_bytes(&prims.triangle(id), sizeof(Triangle));
+  }
+};
 
-AABB refresh_leaf_blocks(Triangle4* blocks, const uint32_t* ids, uint32_t count, const TrianglePrims& prims) {
-  // Lanes are written in place (padding lanes keep the zero-area triangle of the build); the bounds of a
-  // full block come from four-lane min and max over its three corners, a partial block's lane by lane.
-  __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);  // lanes x, y, z (the fourth unused)
-  for (uint32_t s = 0, b = 0; s < count; s += 4, ++b) {
-    Triangle4& block = blocks[b];
-    const uint32_t m = std::min(4u, count - s);
-    for (uint32_t j = 0; j < m; ++j) {
-      const Triangle& t = prims.triangle(ids[s + j]);
-      block.set_lane(int(j), t);  // the kernel's terms, as pack_leaf_blocks stores them
-      const vec3* corners[3] = {&t.v0, &t.v1, &t.v2};
-      for (int c = 0; c < 3; ++c) {
-        const __m128 p = _mm_setr_ps(corners[c]->x, corners[c]->y, corners[c]->z, 0.0f);
-        lo = _mm_min_ps(lo, p);
-        hi = _mm_max_ps(hi, p);
-      }
-    }
+/// The corners of triangle `id` of an indexed mesh, through its index triple.
+struct MeshCorners {
+  const Mesh& mesh;
+  Triangle operator()(uint32_t id) const { return mesh.triangle(id); }
+  /// The three corners of triangle id as four lanes each.
+  void lanes(uint32_t id, __m128* p) const {
+    const glm::uvec3& t = mesh.triangles[id];
+    for (int c = 0; c < 3; ++c) p[c] = lanes_of(mesh.vertices[t[c]]);
   }
+  /// Prefetches what lane k's successors will read: their index triples, then their vertices.
+  void prefetch(const uint32_t* ids, size_t k, size_t n) const {
+    if (k + kIndexAhead < n && ids[k + kIndexAhead] != kInvalidId)
+      prefetch_bytes(&mesh.triangles[ids[k + kIndexAhead]], sizeof(glm::uvec3));
+    if (k + kCornerAhead >= n || ids[k + kCornerAhead] == kInvalidId) return;
+    const glm::uvec3& t = mesh.triangles[ids[k + kCornerAhead]];
+    for (int c = 0; c < 3; ++c) prefetch_bytes(&mesh.vertices[t[c]], sizeof(vec3));
+  }
+};
+
+/// The box of four-lane minima and maxima (x, y, z lanes; the fourth unused).
+AABB box_of_lanes(__m128 lo, __m128 hi) {
   alignas(16) float l[4], h[4];
   _mm_store_ps(l, lo);
   _mm_store_ps(h, hi);
+  return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+}
+
+/// Copies the triangles order[first, first + count) into tris (the same places) through `corners` and
+/// returns their bounds (the one fold of both sources: the same bits whichever gives the triangles).
+template <class Corners>
+AABB copy_leaf_triangles(std::vector<Triangle>& tris, const std::vector<uint32_t>& order, uint32_t first,
+                         uint32_t count, const Corners& corners) {
   AABB box;
-  if (count > 0) box = {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+  for (uint32_t k = first; k < first + count; ++k) {
+    corners.prefetch(order.data(), k, order.size());
+    tris[k] = corners(order[k]);
+    box.extend(tris[k].bounds());
+  }
   return box;
+}
+
+/// Writes one block whose lanes j < m hold the triangles ids[0, m) (the rest the zero-area triangle, all
+/// terms zero, as pack_leaf_blocks leaves them) and folds their corners into lo and hi. The four triangles'
+/// corners are transposed into rows and their terms made on four lanes at once: triangle_terms' IEEE
+/// operations lane by lane, so the bits Triangle4::set_lane stores for each.
+template <class Corners>
+void write_block(Triangle4& block, const uint32_t* ids, uint32_t m, const Corners& corners, __m128& lo,
+                 __m128& hi) {
+  __m128 q[4][3];  // q[lane][corner] = (x, y, z, 0)
+  for (uint32_t j = 0; j < 4; ++j) {
+    if (j >= m) {
+      q[j][0] = q[j][1] = q[j][2] = _mm_setzero_ps();
+      continue;
+    }
+    corners.lanes(ids[j], q[j]);
+    for (int c = 0; c < 3; ++c) lo = _mm_min_ps(lo, q[j][c]), hi = _mm_max_ps(hi, q[j][c]);
+  }
+  Vec3T<Lanes4> v[3];
+  for (int c = 0; c < 3; ++c) {
+    __m128 x = q[0][c], y = q[1][c], z = q[2][c], w = q[3][c];
+    _MM_TRANSPOSE4_PS(x, y, z, w);  // rows x, y, z (and the zero row)
+    v[c] = {Lanes4(x), Lanes4(y), Lanes4(z)};
+  }
+  const TriangleTerms<Lanes4> terms = triangle_terms(v[0], v[1], v[2]);
+  const Vec3T<Lanes4>* rows[4] = {&terms.v0, &terms.e1, &terms.e2, &terms.n};
+  for (int r = 0; r < 4; ++r) {
+    _mm_store_ps(block.row[r][0], rows[r]->x.v);
+    _mm_store_ps(block.row[r][1], rows[r]->y.v);
+    _mm_store_ps(block.row[r][2], rows[r]->z.v);
+  }
+}
+
+/// Writes the (count + 3) / 4 blocks of the wide leaf from block `first` on through `corners` and returns
+/// their bounds.
+template <class Corners>
+AABB write_leaf_blocks(Bvh8LeafBlocks& leaves, uint32_t first, uint32_t count, const Corners& corners) {
+  __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
+  const uint32_t* ids = leaves.ids.data();
+  for (uint32_t s = 0, b = first; s < count; s += 4, ++b) {
+    for (size_t j = 0; j < 4; ++j) corners.prefetch(ids, 4 * size_t(b) + j, leaves.ids.size());
+    write_block(leaves.blocks[b], ids + 4 * size_t(b), std::min(4u, count - s), corners, lo, hi);
+  }
+  return count > 0 ? box_of_lanes(lo, hi) : AABB{};
+}
+
+}  // namespace
+
+AABB wide_node_box(const Bvh8Node& node) {
+  AABB box;
+  for (int a = 0; a < 3; ++a) {
+    float lo = kInf, hi = -kInf;
+    for (int j = 0; j < Bvh8Node::kWidth; ++j) {
+      lo = std::min(lo, node.bounds[a][j]);
+      hi = std::max(hi, node.bounds[3 + a][j]);
+    }
+    box.lo[a] = lo, box.hi[a] = hi;
+  }
+  return box;
+}
+
+AABB refresh_leaf_triangles(std::vector<Triangle>& tris, const std::vector<uint32_t>& order, uint32_t first,
+                            uint32_t count, const TrianglePrims& prims) {
+  return copy_leaf_triangles(tris, order, first, count, PrimsCorners{prims});
+}
+
+AABB refresh_leaf_triangles(std::vector<Triangle>& tris, const std::vector<uint32_t>& order, uint32_t first,
+                            uint32_t count, const Mesh& mesh) {
+  return copy_leaf_triangles(tris, order, first, count, MeshCorners{mesh});
+}
+
+AABB refresh_leaf_blocks(Bvh8LeafBlocks& leaves, uint32_t first, uint32_t count, const TrianglePrims& prims) {
+  return write_leaf_blocks(leaves, first, count, PrimsCorners{prims});
+}
+
+AABB refresh_leaf_blocks(Bvh8LeafBlocks& leaves, uint32_t first, uint32_t count, const Mesh& mesh) {
+  return write_leaf_blocks(leaves, first, count, MeshCorners{mesh});
 }
 
 }  // namespace ab

@@ -5,15 +5,22 @@
 // the same union of the same primitives' bounds (min and max are exact), so a refitted box contains its
 // triangles exactly as a built one does and the traversal's widening (box_test.h) keeps hits identical.
 //
-// The binary and the wide arrays both store every child after its parent (depth-first pairs; the collapse
-// appends wide children), so one reverse pass over the array is bottom-up. Leaves are refitted in parallel;
-// the interior pass is serial (a few percent of the leaves' work).
+// As Embree's BVHNRefitter (kernels/bvh/bvh_refit.cpp), the tree is refitted by subtrees in one post-order
+// pass: a node's children are refitted first (in parallel near the root, serially below), then its boxes
+// are their unions, so every node and leaf block is written once and no node waits on another task. The
+// triangles come either from a TrianglePrims (the copy in id order) or straight from the frame's indexed
+// Mesh, gathered through the leaf order the build stored (refit(mesh): no copy of the frame is made first).
+// The boxes are unions in a fixed order, so the tree is bit for bit the same on any thread count and from
+// either source.
 #pragma once
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
+#include <algorithm>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -22,23 +29,25 @@
 #include "accel/bvh/node.h"
 #include "accel/bvh/node8.h"
 #include "accel/core/aabb.h"
+#include "accel/core/mesh.h"
 #include "accel/core/primitives.h"
 #include "accel/core/triangle.h"
 #include "accel/core/triangle4.h"
 
 namespace ab {
 
-/// Recomputes every interior box of a binary BVH (build_bvh's layout) from its children, bottom-up; leaf
-/// boxes must already be current.
-void refit_binary_interiors(BvhNodeArray& nodes);
-/// Recomputes every interior lane box of an 8-wide BVH from the lanes of the node it points to, bottom-up;
-/// leaf lane boxes must already be current.
-void refit_wide_interiors(Bvh8NodeArray& wide);
-/// Copies the `count` triangles `ids` of prims into `out` (leaf order) and returns their bounds.
-AABB refresh_leaf_triangles(Triangle* out, const uint32_t* ids, uint32_t count, const TrianglePrims& prims);
-/// Repacks the (count + 3) / 4 blocks of a wide leaf from the triangles `ids` (four lanes per block, padding
-/// lanes kInvalidId) and returns their bounds.
-AABB refresh_leaf_blocks(Triangle4* blocks, const uint32_t* ids, uint32_t count, const TrianglePrims& prims);
+/// Copies the triangles order[first, first + count) of prims into tris[first, first + count) (leaf order)
+/// and returns their bounds.
+AABB refresh_leaf_triangles(std::vector<Triangle>& tris, const std::vector<uint32_t>& order, uint32_t first,
+                            uint32_t count, const TrianglePrims& prims);
+/// The same with the triangles gathered from the indexed mesh (its vertices through its index triples).
+AABB refresh_leaf_triangles(std::vector<Triangle>& tris, const std::vector<uint32_t>& order, uint32_t first,
+                            uint32_t count, const Mesh& mesh);
+/// Repacks the (count + 3) / 4 blocks of the wide leaf from block `first` on from the triangles of their
+/// lanes' ids (padding lanes kInvalidId: the zero-area triangle) and returns their bounds.
+AABB refresh_leaf_blocks(Bvh8LeafBlocks& leaves, uint32_t first, uint32_t count, const TrianglePrims& prims);
+/// The same with the triangles gathered from the indexed mesh.
+AABB refresh_leaf_blocks(Bvh8LeafBlocks& leaves, uint32_t first, uint32_t count, const Mesh& mesh);
 
 /// The union of the bounds of primitives ids[0, count) of prims.
 template <class P>
@@ -48,41 +57,70 @@ AABB leaf_prim_bounds(const P& prims, const uint32_t* ids, uint32_t count) {
   return box;
 }
 
-/// Sets every leaf box of a binary BVH to leaf_box(first, count) (in parallel), then the interiors.
+/// Subtrees at most this deep below the root are refitted as parallel tasks (8^3 wide or 2^9 binary
+/// subtrees below them: enough to balance any thread count the harness uses).
+inline constexpr int kRefitParallelDepthWide = 3;
+inline constexpr int kRefitParallelDepthBinary = 9;
+
+/// The union of the eight lane boxes of a wide node (unused lanes hold the empty box).
+AABB wide_node_box(const Bvh8Node& node);
+
+/// Refits the subtree of wide node i (children first): a leaf lane's box is leaf_box(child, count), an
+/// interior lane's the union of its node's lanes. Returns the union of node i's lanes.
 template <class LeafBox>
-void refit_binary(BvhNodeArray& nodes, LeafBox&& leaf_box) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size(), 1024),
-                    [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i < r.end(); ++i) {
-                        BvhNode& n = nodes[i];
-                        if (i == 1 || !n.is_leaf()) continue;  // node 1 is padding
-                        const AABB box = leaf_box(n.offset, n.count);
-                        for (int a = 0; a < 3; ++a) n.lo[a] = box.lo[a], n.hi[a] = box.hi[a];
-                      }
-                    });
-  refit_binary_interiors(nodes);
+AABB refit_wide_subtree(Bvh8NodeArray& wide, uint32_t i, int depth, const LeafBox& leaf_box) {
+  Bvh8Node& node = wide[i];
+  const auto lane = [&](int k) {
+    if (node.count[k] == 0 && node.child[k] == 0) return;  // an unused lane
+    const AABB box = node.count[k] != 0 ? leaf_box(node.child[k], node.count[k])
+                                        : refit_wide_subtree(wide, node.child[k], depth + 1, leaf_box);
+    for (int a = 0; a < 3; ++a) node.bounds[a][k] = box.lo[a], node.bounds[3 + a][k] = box.hi[a];
+  };
+  if (depth < kRefitParallelDepthWide)
+    tbb::parallel_for(0, Bvh8Node::kWidth, lane);
+  else
+    for (int k = 0; k < Bvh8Node::kWidth; ++k) lane(k);
+  return wide_node_box(node);
 }
 
-/// Sets every leaf lane box of an 8-wide BVH to leaf_box(child, count) (in parallel), then the interiors.
+/// Refits the subtree of binary node i (children first; build_bvh's layout, the children of node i at
+/// offset and offset + 1): a leaf's box is leaf_box(offset, count). Returns node i's new box.
 template <class LeafBox>
-void refit_wide(Bvh8NodeArray& wide, LeafBox&& leaf_box) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide.size(), 256),
-                    [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i < r.end(); ++i) {
-                        Bvh8Node& node = wide[i];
-                        for (int k = 0; k < Bvh8Node::kWidth; ++k) {
-                          if (node.count[k] == 0) continue;
-                          const AABB box = leaf_box(node.child[k], node.count[k]);
-                          for (int a = 0; a < 3; ++a)
-                            node.bounds[a][k] = box.lo[a], node.bounds[3 + a][k] = box.hi[a];
-                        }
-                      }
-                    });
-  refit_wide_interiors(wide);
+AABB refit_binary_subtree(BvhNodeArray& nodes, uint32_t i, int depth, const LeafBox& leaf_box) {
+  BvhNode& n = nodes[i];
+  AABB box;
+  if (n.is_leaf()) {
+    box = leaf_box(n.offset, n.count);
+  } else {
+    const auto child = [&](uint32_t c) { refit_binary_subtree(nodes, c, depth + 1, leaf_box); };
+    if (depth < kRefitParallelDepthBinary)
+      tbb::parallel_invoke([&] { child(n.offset); }, [&] { child(n.offset + 1); });
+    else
+      child(n.offset), child(n.offset + 1);
+    const BvhNode& l = nodes[n.offset];
+    const BvhNode& r = nodes[n.offset + 1];
+    for (int a = 0; a < 3; ++a)
+      box.lo[a] = std::min(l.lo[a], r.lo[a]), box.hi[a] = std::max(l.hi[a], r.hi[a]);
+  }
+  for (int a = 0; a < 3; ++a) n.lo[a] = box.lo[a], n.hi[a] = box.hi[a];
+  return box;
+}
+
+/// Refits a binary BVH (leaf boxes from leaf_box(first, count)); returns the root's box (empty: no nodes).
+template <class LeafBox>
+AABB refit_binary(BvhNodeArray& nodes, const LeafBox& leaf_box) {
+  return nodes.empty() ? AABB{} : refit_binary_subtree(nodes, 0, 0, leaf_box);
+}
+
+/// Refits an 8-wide BVH (leaf lane boxes from leaf_box(child, count)); returns the union of the root's
+/// lanes (empty: no nodes).
+template <class LeafBox>
+AABB refit_wide(Bvh8NodeArray& wide, const LeafBox& leaf_box) {
+  return wide.empty() ? AABB{} : refit_wide_subtree(wide, 0, 0, leaf_box);
 }
 
 /// The refit of a Bvh (bvh.h) over its primitive set's new positions; a friend of Bvh, so the BVH classes
-/// carry only the hook that calls it.
+/// carry only the hooks that call it.
 template <class B>
 struct BvhRefit {
   /// Refits b over `prims` (same primitive count and ids). False, with b unchanged, when Q is not b's
@@ -93,34 +131,48 @@ struct BvhRefit {
       return false;
     } else {
       if (!prims || !b.prims_ || prims->size() != b.prims_->size()) return false;
-      b.prims_ = std::move(prims);
-      const auto& p = *b.prims_;
-      if (b.config_.width == 8) {
-        refit_wide_tree(b, p);
-        b.binary_.sah_cost = 0.0;  // the binary tree is gone: its SAH cost is not computed after a refit
-      } else if (!b.nodes_.empty()) {
-        refit_binary(b.nodes_, [&](uint32_t first, uint32_t count) {
-          if constexpr (B::kCopiesTriangles)
-            return refresh_leaf_triangles(&b.tris_[first], &b.order_[first], count, p);
-          else
-            return leaf_prim_bounds(p, &b.order_[first], count);
-        });
+      {
+        const std::lock_guard<std::mutex> lock(b.frame_mutex_);
+        b.frame_mesh_.reset();
+        b.prims_ = std::move(prims);
       }
+      refit_from(b, *b.prims_);
+      b.bounds_ = b.prims_->bounds();
       return true;
     }
   }
 
+  /// Refits b (a BVH over triangles) straight from the frame's indexed mesh (same triangle count and ids):
+  /// the leaves gather their triangles from it; b's TrianglePrims of the frame is made only when something
+  /// asks for it (a rebuild, the quality metrics: Bvh::current_prims). False, with b unchanged, when the
+  /// count differs.
+  static bool refit_mesh(B& b, std::shared_ptr<const Mesh> mesh) {
+    if (!mesh || !b.prims_ || mesh->size() != b.prims_->size()) return false;
+    b.bounds_ = refit_from(b, *mesh);
+    const std::lock_guard<std::mutex> lock(b.frame_mutex_);
+    b.frame_mesh_ = std::move(mesh);
+    return true;
+  }
+
  private:
-  /// The wide tree: triangle blocks repacked (lane j of leaf block child + j / 4 is ids[4 child + j]) or
-  /// other primitives' bounds through the leaf order.
-  template <class P>
-  static void refit_wide_tree(B& b, const P& p) {
-    if (b.wide_.empty()) return;
-    refit_wide(b.wide_, [&](uint32_t first, uint32_t count) {
+  /// Refits the tree of b from `source` (its primitive set, or a Mesh for triangles); returns the union of
+  /// the leaves' boxes.
+  template <class S>
+  static AABB refit_from(B& b, const S& source) {
+    if (b.config_.width == 8) {
+      b.binary_.sah_cost = 0.0;  // the binary tree is gone: its SAH cost is not computed after a refit
+      return refit_wide(b.wide_, [&](uint32_t first, uint32_t count) {
+        if constexpr (B::kCopiesTriangles)
+          return refresh_leaf_blocks(b.blocks_, first, count, source);
+        else
+          return leaf_prim_bounds(source, &b.order_[first], count);
+      });
+    }
+    return refit_binary(b.nodes_, [&](uint32_t first, uint32_t count) {
       if constexpr (B::kCopiesTriangles)
-        return refresh_leaf_blocks(&b.blocks_.blocks[first], &b.blocks_.ids[4 * size_t(first)], count, p);
+        return refresh_leaf_triangles(b.tris_, b.order_, first, count, source);
       else
-        return leaf_prim_bounds(p, &b.order_[first], count);
+        return leaf_prim_bounds(source, &b.order_[first], count);
     });
   }
 };

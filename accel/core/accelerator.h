@@ -13,11 +13,12 @@
 
 #include "accel/core/aabb.h"
 #include "accel/core/memory.h"
+#include "accel/core/mesh.h"
+#include "accel/core/primitives.h"
 #include "accel/core/stats.h"
 
 namespace ab {
 
-class TrianglePrims;
 class InstancePrims;
 
 /// An acceleration structure over one primitive set.
@@ -44,6 +45,12 @@ class Accelerator {
   /// on success stats() describe the refitted structure and build_seconds is the refit's wall time.
   bool refit(std::shared_ptr<const TrianglePrims> geometry) {
     return timed_refit([&] { return do_refit_triangles(std::move(geometry)); });
+  }
+  /// The same from the frame's indexed mesh (new vertex positions, the same triangles): the whole cost of
+  /// making the structure traversable for that frame. BVHs over triangles gather their leaves from the mesh
+  /// itself; other structures get the frame's TrianglePrims made inside the timing.
+  bool refit(std::shared_ptr<const Mesh> mesh) {
+    return timed_refit([&] { return do_refit_mesh(std::move(mesh)); });
   }
   /// The same for a top level over instances that moved (their bottom levels already updated).
   bool refit(std::shared_ptr<const InstancePrims> instances) {
@@ -95,6 +102,10 @@ class Accelerator {
   virtual void gather_stats(BuildStats& stats) const { (void)stats; }
   /// The refit over moved triangles (refit()); false when unsupported.
   virtual bool do_refit_triangles(std::shared_ptr<const TrianglePrims>) { return false; }
+  /// The refit from a frame's mesh (refit()): by default the frame's TrianglePrims, refitted over.
+  virtual bool do_refit_mesh(std::shared_ptr<const Mesh> mesh) {
+    return do_refit_triangles(std::make_shared<const TrianglePrims>(std::move(mesh)));
+  }
   /// The refit over moved instances (refit()); false when unsupported.
   virtual bool do_refit_instances(std::shared_ptr<const InstancePrims>) { return false; }
   /// Fills the expensive quality metrics of the finished structure (measure_quality()).
