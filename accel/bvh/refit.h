@@ -6,7 +6,7 @@
 // triangles exactly as a built one does and the traversal's widening (box_test.h) keeps hits identical.
 //
 // As Embree's BVHNRefitter (kernels/bvh/bvh_refit.cpp), the tree is refitted by subtrees in one post-order
-// pass: a node's children are refitted first (in parallel near the root, serially below), then its boxes
+// pass: a node's children are refitted first (in parallel for large subtrees, serially below), then its boxes
 // are their unions, so every node and leaf block is written once and no node waits on another task. The
 // triangles come either from a TrianglePrims (the copy in id order) or straight from the frame's indexed
 // Mesh, gathered through the leaf order the build stored (refit(mesh): no copy of the frame is made first).
@@ -57,48 +57,65 @@ AABB leaf_prim_bounds(const P& prims, const uint32_t* ids, uint32_t count) {
   return box;
 }
 
-/// Subtrees at most this deep below the root are refitted as parallel tasks (8^3 wide or 2^9 binary
-/// subtrees below them: enough to balance any thread count the harness uses).
-inline constexpr int kRefitParallelDepthWide = 3;
-inline constexpr int kRefitParallelDepthBinary = 9;
+/// Subtrees of more than this many nodes are refitted as parallel tasks, smaller ones serially by the task
+/// that reaches them: tasks of a few thousand triangles, balanced however uneven the tree. Both arrays are
+/// depth-first (the collapse recurses into a child as soon as it allocates it; build_bvh writes each pair's
+/// subtrees after it), so a subtree's nodes are the index range from its root to the next sibling's subtree;
+/// a wrong layout would only misjudge sizes, never boxes.
+inline constexpr uint32_t kRefitTaskNodesWide = 64;
+inline constexpr uint32_t kRefitTaskNodesBinary = 1024;
 
 /// The union of the eight lane boxes of a wide node (unused lanes hold the empty box).
 AABB wide_node_box(const Bvh8Node& node);
 
-/// Refits the subtree of wide node i (children first): a leaf lane's box is leaf_box(child, count), an
-/// interior lane's the union of its node's lanes. Returns the union of node i's lanes.
+/// Refits the subtree of wide node i, whose nodes are [i, end) (children first): a leaf lane's box is
+/// leaf_box(child, count), an interior lane's the union of its node's lanes. Returns the union of node i's
+/// lanes.
 template <class LeafBox>
-AABB refit_wide_subtree(Bvh8NodeArray& wide, uint32_t i, int depth, const LeafBox& leaf_box) {
+AABB refit_wide_subtree(Bvh8NodeArray& wide, uint32_t i, uint32_t end, const LeafBox& leaf_box) {
   Bvh8Node& node = wide[i];
+  uint32_t ends[Bvh8Node::kWidth];  // the end of each interior lane's subtree: the next interior lane's node
+  for (int k = Bvh8Node::kWidth, next = int(end); k-- > 0;) {
+    ends[k] = uint32_t(next);
+    if (node.count[k] == 0 && node.child[k] != 0) next = int(node.child[k]);
+  }
   const auto lane = [&](int k) {
     if (node.count[k] == 0 && node.child[k] == 0) return;  // an unused lane
     const AABB box = node.count[k] != 0 ? leaf_box(node.child[k], node.count[k])
-                                        : refit_wide_subtree(wide, node.child[k], depth + 1, leaf_box);
+                                        : refit_wide_subtree(wide, node.child[k], ends[k], leaf_box);
     for (int a = 0; a < 3; ++a) node.bounds[a][k] = box.lo[a], node.bounds[3 + a][k] = box.hi[a];
   };
-  if (depth < kRefitParallelDepthWide)
-    tbb::parallel_for(0, Bvh8Node::kWidth, lane);
+  if (end - i > kRefitTaskNodesWide)
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, Bvh8Node::kWidth, 1),
+        [&](const tbb::blocked_range<int>& r) {
+          for (int k = r.begin(); k < r.end(); ++k) lane(k);
+        },
+        tbb::simple_partitioner());
   else
     for (int k = 0; k < Bvh8Node::kWidth; ++k) lane(k);
   return wide_node_box(node);
 }
 
-/// Refits the subtree of binary node i (children first; build_bvh's layout, the children of node i at
-/// offset and offset + 1): a leaf's box is leaf_box(offset, count). Returns node i's new box.
+/// Refits the subtree of binary node i, whose nodes are about [i, end) (children first; build_bvh's layout,
+/// the children of node i at offset and offset + 1): a leaf's box is leaf_box(offset, count). Returns node
+/// i's new box.
 template <class LeafBox>
-AABB refit_binary_subtree(BvhNodeArray& nodes, uint32_t i, int depth, const LeafBox& leaf_box) {
+AABB refit_binary_subtree(BvhNodeArray& nodes, uint32_t i, uint32_t end, const LeafBox& leaf_box) {
   BvhNode& n = nodes[i];
   AABB box;
   if (n.is_leaf()) {
     box = leaf_box(n.offset, n.count);
   } else {
-    const auto child = [&](uint32_t c) { refit_binary_subtree(nodes, c, depth + 1, leaf_box); };
-    if (depth < kRefitParallelDepthBinary)
-      tbb::parallel_invoke([&] { child(n.offset); }, [&] { child(n.offset + 1); });
-    else
-      child(n.offset), child(n.offset + 1);
     const BvhNode& l = nodes[n.offset];
     const BvhNode& r = nodes[n.offset + 1];
+    const uint32_t split = r.is_leaf() ? end : r.offset;  // the left subtree's nodes come first
+    const auto left = [&] { refit_binary_subtree(nodes, n.offset, split, leaf_box); };
+    const auto right = [&] { refit_binary_subtree(nodes, n.offset + 1, end, leaf_box); };
+    if (end - i > kRefitTaskNodesBinary)
+      tbb::parallel_invoke(left, right);
+    else
+      left(), right();
     for (int a = 0; a < 3; ++a)
       box.lo[a] = std::min(l.lo[a], r.lo[a]), box.hi[a] = std::max(l.hi[a], r.hi[a]);
   }
@@ -109,14 +126,14 @@ AABB refit_binary_subtree(BvhNodeArray& nodes, uint32_t i, int depth, const Leaf
 /// Refits a binary BVH (leaf boxes from leaf_box(first, count)); returns the root's box (empty: no nodes).
 template <class LeafBox>
 AABB refit_binary(BvhNodeArray& nodes, const LeafBox& leaf_box) {
-  return nodes.empty() ? AABB{} : refit_binary_subtree(nodes, 0, 0, leaf_box);
+  return nodes.empty() ? AABB{} : refit_binary_subtree(nodes, 0, uint32_t(nodes.size()), leaf_box);
 }
 
 /// Refits an 8-wide BVH (leaf lane boxes from leaf_box(child, count)); returns the union of the root's
 /// lanes (empty: no nodes).
 template <class LeafBox>
 AABB refit_wide(Bvh8NodeArray& wide, const LeafBox& leaf_box) {
-  return wide.empty() ? AABB{} : refit_wide_subtree(wide, 0, 0, leaf_box);
+  return wide.empty() ? AABB{} : refit_wide_subtree(wide, 0, uint32_t(wide.size()), leaf_box);
 }
 
 /// The refit of a Bvh (bvh.h) over its primitive set's new positions; a friend of Bvh, so the BVH classes

@@ -30,7 +30,7 @@ namespace ab {
 class TrianglePrims {
  public:
   /// Copies the triangles of mesh (which is kept alive for adapters that need the indexed form), in
-  /// parallel (every frame of a refitted animation pays this copy); the same result on any thread count.
+  /// parallel (a BVH refitted from a frame's mesh makes none: refit.h); the same result on any thread count.
   explicit TrianglePrims(std::shared_ptr<const Mesh> mesh);
 
   /// Number of triangles.
