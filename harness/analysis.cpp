@@ -25,20 +25,31 @@ double pearson(const std::vector<double>& x, const std::vector<double>& y) {
   return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : std::nan("");
 }
 
-void fill_ratios(json& report) {
+namespace {
+
+/// Sets `ratio_field` of every row to its `rate_field` over Embree's in the same scene, ray set, query,
+/// thread count and frame.
+void fill_ratio(json& report, const char* rate_field, const char* ratio_field) {
   std::map<std::string, double> embree;
   auto key = [](const json& r) {
     return r.value("scene", "") + "\n" + r.value("rays", "") + "\n" + r.value("query", "") + "\n" +
            std::to_string(r.value("threads", -1)) + "\n" + r.value("frame", json()).dump();
   };
   for (const json& r : report["results"])
-    if (r.value("accelerator", "") == kEmbreeName && r.contains("rays_per_second") && !embree.count(key(r)))
-      embree[key(r)] = r["rays_per_second"].get<double>();
+    if (r.value("accelerator", "") == kEmbreeName && r.contains(rate_field) && !embree.count(key(r)))
+      embree[key(r)] = r[rate_field].get<double>();
   for (json& r : report["results"]) {
     const auto it = embree.find(key(r));
-    if (r.contains("rays_per_second") && it != embree.end() && it->second > 0)
-      r["ratio_to_embree"] = r["rays_per_second"].get<double>() / it->second;
+    if (r.contains(rate_field) && it != embree.end() && it->second > 0)
+      r[ratio_field] = r[rate_field].get<double>() / it->second;
   }
+}
+
+}  // namespace
+
+void fill_ratios(json& report) {
+  fill_ratio(report, "rays_per_second", "ratio_to_embree");
+  fill_ratio(report, "rays_per_cpu_second", "cpu_ratio_to_embree");
 }
 
 namespace {
@@ -111,7 +122,9 @@ void add_row(ConfigSummary& s, const json& row, int max_threads) {
   const bool all = row.value("threads_used", 0) == max_threads;
   const double mrays = row.value("rays_per_second", 0.0) / 1e6;
   const json ratio = row.value("ratio_to_embree", json());
-  if (one) s.ratio_one.add(ratio), s.mrays_one.add(mrays);
+  if (one)
+    s.ratio_one.add(ratio), s.mrays_one.add(mrays),
+        s.cpu_ratio_one.add(row.value("cpu_ratio_to_embree", json()));
   if (all) s.ratio_all.add(ratio), s.mrays_all.add(mrays);
   if (one) s.nodes.add(row.value("nodes_per_ray", json())), s.prims.add(row.value("prims_per_ray", json()));
 }

@@ -13,7 +13,8 @@ namespace ab {
 double pearson(const std::vector<double>& x, const std::vector<double>& y);
 
 /// Sets every result row's ratio_to_embree: its rays/s over the rays/s of the first "embree" configuration
-/// on the same scene, ray set, query and thread count (rows without such an Embree row keep null).
+/// on the same scene, ray set, query and thread count (rows without such an Embree row keep null), and
+/// cpu_ratio_to_embree, the same by rays per cpu second.
 void fill_ratios(nlohmann::json& report);
 
 /// Replaces report["sah_correlation"]: per scene and ray set, Pearson's r between each configuration's
@@ -34,6 +35,7 @@ struct GeoMean {
 /// One configuration's line of the summary table: geometric means over scenes and ray sets.
 struct ConfigSummary {
   GeoMean ratio_one, ratio_all;  ///< ratio_to_embree, closest hit, at 1 thread and at all threads
+  GeoMean cpu_ratio_one;         ///< cpu_ratio_to_embree, closest hit, at 1 thread
   GeoMean mrays_one, mrays_all;  ///< Mrays/s, closest hit, at 1 thread and at all threads
   GeoMean build_rate;            ///< million triangles built per second
   GeoMean nodes, prims;          ///< per ray, closest hit at 1 thread

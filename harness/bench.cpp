@@ -33,6 +33,18 @@ double seconds_per_pass(const benchmark::BenchmarkReporter::Run& r) {
   return r.iterations > 0 ? r.real_accumulated_time / double(r.iterations) : r.real_accumulated_time;
 }
 
+/// Cpu seconds (of the process, all threads) per pass of an iteration run.
+double cpu_seconds_per_pass(const benchmark::BenchmarkReporter::Run& r) {
+  return r.iterations > 0 ? r.cpu_accumulated_time / double(r.iterations) : r.cpu_accumulated_time;
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t h = v.size() / 2;
+  return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+
 }  // namespace
 
 int64_t iterations_for(double pass_seconds, double min_time) {
@@ -75,6 +87,7 @@ Timing summarize(const std::vector<benchmark::BenchmarkReporter::Run>& runs, int
   for (const auto& r : runs) {
     if (r.run_type == benchmark::BenchmarkReporter::Run::RT_Iteration) {
       per_rep.push_back(seconds_per_pass(r));
+      t.cpu_samples.push_back(cpu_seconds_per_pass(r));
       continue;
     }
     const double s = seconds_per_pass(r);
@@ -91,6 +104,7 @@ Timing summarize(const std::vector<benchmark::BenchmarkReporter::Run>& runs, int
   }
   if (per_rep.size() == 1) t.median = t.mean = t.min = t.max = per_rep.front();  // no aggregates for one run
   t.samples = std::move(per_rep);
+  t.cpu_median = median_of(t.cpu_samples);
   return t;
 }
 
@@ -113,6 +127,7 @@ Timing BenchTimer::time(const std::string& name, int repetitions, int64_t iterat
   };
   benchmark::RegisterBenchmark(name.c_str(), body)
       ->UseManualTime()
+      ->MeasureProcessCPUTime()
       ->Iterations(std::max<int64_t>(1, iterations))
       ->Repetitions(std::max(1, repetitions))
       ->ComputeStatistics("min", stat_min)

@@ -24,6 +24,10 @@ struct Timing {
   int repetitions = 0;          ///< repetitions timed
   int64_t iterations = 0;       ///< passes per repetition
   std::vector<double> samples;  ///< seconds per pass of each repetition, in order (for `compare`)
+  /// Cpu seconds of the whole process (every thread) per pass: the median over the repetitions and each
+  /// repetition's, in order. Time the process spent waiting for a core on a loaded machine is not in it.
+  double cpu_median = 0.0;
+  std::vector<double> cpu_samples;  ///< cpu seconds per pass of each repetition
 };
 
 /// Passes per repetition so that a repetition lasts at least `min_time` seconds, given one pass's time.

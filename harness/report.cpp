@@ -38,6 +38,9 @@ const std::vector<std::string>& csv_columns() {
                                                 "rays_per_second_min",
                                                 "rays_per_second_max",
                                                 "ratio_to_embree",
+                                                "cpu_seconds_median",
+                                                "rays_per_cpu_second",
+                                                "cpu_ratio_to_embree",
                                                 "nodes_per_ray",
                                                 "leaves_per_ray",
                                                 "prims_per_ray",
@@ -170,20 +173,22 @@ void print_summary_table(std::ostream& out, const nlohmann::json& report, bool c
   const int max_threads = report.value("max_threads", 0);
   const Colors c = colors(color);
   out << "geometric means over scenes and ray sets (closest hit); ratio = rays/s / embree's rays/s in this "
-         "run\n";
+         "run; cpu@1 = the same by the process's cpu time\n";
   out << std::left << std::setw(30) << "accelerator" << std::right << std::setw(9) << "ratio@1"
-      << std::setw(9) << ("ratio@" + std::to_string(max_threads)) << std::setw(10) << "Mray/s@1"
-      << std::setw(10) << ("Mray/s@" + std::to_string(max_threads)) << std::setw(11) << "build Mt/s"
-      << std::setw(8) << "B/tri" << std::setw(10) << "nodes/ray" << std::setw(10) << "tris/ray"
+      << std::setw(7) << "cpu@1" << std::setw(9) << ("ratio@" + std::to_string(max_threads)) << std::setw(10)
+      << "Mray/s@1" << std::setw(10) << ("Mray/s@" + std::to_string(max_threads)) << std::setw(11)
+      << "build Mt/s" << std::setw(8) << "B/tri" << std::setw(10) << "nodes/ray" << std::setw(10)
+      << "tris/ray"
       << "  verified\n";
   for (const auto& label : order) {
     const ConfigSummary& s = by_config.at(label);
     out << std::left << std::setw(30) << label.substr(0, 29) << std::right << std::setw(9)
-        << fmt(s.ratio_one.value(), 2) << std::setw(9) << fmt(s.ratio_all.value(), 2) << std::setw(10)
-        << fmt(s.mrays_one.value(), 2) << std::setw(10) << fmt(s.mrays_all.value(), 2) << std::setw(11)
-        << fmt(s.build_rate.value(), 2) << std::setw(8) << fmt(s.bytes.value(), 1) << std::setw(10)
-        << fmt(s.nodes.value(), 1) << std::setw(10) << fmt(s.prims.value(), 1) << "  "
-        << (s.verified ? c.green : c.red) << (s.verified ? "ok" : "FAILED") << c.reset << "\n";
+        << fmt(s.ratio_one.value(), 2) << std::setw(7) << fmt(s.cpu_ratio_one.value(), 2) << std::setw(9)
+        << fmt(s.ratio_all.value(), 2) << std::setw(10) << fmt(s.mrays_one.value(), 2) << std::setw(10)
+        << fmt(s.mrays_all.value(), 2) << std::setw(11) << fmt(s.build_rate.value(), 2) << std::setw(8)
+        << fmt(s.bytes.value(), 1) << std::setw(10) << fmt(s.nodes.value(), 1) << std::setw(10)
+        << fmt(s.prims.value(), 1) << "  " << (s.verified ? c.green : c.red) << (s.verified ? "ok" : "FAILED")
+        << c.reset << "\n";
   }
   print_verification_line(out, report);
   print_correlation_line(out, report);

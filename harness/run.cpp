@@ -321,6 +321,7 @@ void Runner::add_timed_row(json row, const Timing& t, int threads, const std::st
   row["query"] = query;
   row.update(query_timing_fields(t, threads, row["ray_count"].get<double>()));
   row["ratio_to_embree"] = nullptr;
+  row["cpu_ratio_to_embree"] = nullptr;
   row[query == "closest" ? "thread_mismatches" : "any_hit_mismatches"] = mismatches;
   if (mismatches && (query == "closest" || is_exact(row["accelerator"].get<std::string>())))
     row["verified"] = false;

@@ -54,7 +54,10 @@ nlohmann::json query_timing_fields(const Timing& t, int threads, double rays) {
           {"seconds_samples", t.samples},
           {"rays_per_second", t.median > 0 ? rays / t.median : 0.0},
           {"rays_per_second_min", t.max > 0 ? rays / t.max : 0.0},
-          {"rays_per_second_max", t.min > 0 ? rays / t.min : 0.0}};
+          {"rays_per_second_max", t.min > 0 ? rays / t.min : 0.0},
+          {"cpu_seconds_median", t.cpu_median},
+          {"cpu_seconds_samples", t.cpu_samples},
+          {"rays_per_cpu_second", t.cpu_median > 0 ? rays / t.cpu_median : 0.0}};
 }
 
 }  // namespace ab

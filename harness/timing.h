@@ -39,7 +39,8 @@ class SuiteTimer {
 nlohmann::json timing_json(const Timing& t);
 
 /// The timing fields of a query's result row: threads (asked and used), repetitions, iterations, seconds
-/// (median, min, max, mean, stddev) and rays per second (median, min, max) over `rays` rays.
+/// (median, min, max, mean, stddev) and rays per second (median, min, max) over `rays` rays, and the
+/// process's cpu seconds per pass (median, samples) with rays per cpu second.
 nlohmann::json query_timing_fields(const Timing& t, int threads, double rays);
 
 }  // namespace ab

@@ -79,12 +79,21 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   return cells;
 }
 
-std::string fresh_dir(const std::string& name) {
-  const fs::path d =
-      fs::path(::testing::TempDir()) / ("accelbench_run_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  return d.string();
-}
+/// A fresh output folder for one run and its companions (DIR.json, DIR.err, DIR.out), all removed when the
+/// test ends, however it ends.
+struct RunDir {
+  explicit RunDir(const std::string& name)
+      : path((fs::path(::testing::TempDir()) / ("accelbench_run_" + name + "_" + std::to_string(::getpid())))
+                 .string()) {
+    remove_files();
+  }
+  ~RunDir() { remove_files(); }
+  void remove_files() const {
+    fs::remove_all(path);
+    for (const char* ext : {".json", ".err", ".out"}) fs::remove(path + ext);
+  }
+  const std::string path;
+};
 
 /// Every CSV cell equals the JSON value of the same row and column.
 void expect_csv_matches_json(const json& report, const std::string& csv_text) {
@@ -116,7 +125,8 @@ void expect_csv_matches_json(const json& report, const std::string& csv_text) {
 
 TEST(Run, QuickSuiteEndToEnd) {
   if (test::accelbench_bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
-  const std::string dir = fresh_dir("quick");
+  const RunDir run_dir("quick");
+  const std::string& dir = run_dir.path;
   const std::string suite = std::string(ACCELBENCH_SOURCE_DIR) + "/suites/quick.json";
   ASSERT_EQ(shell("'" + test::accelbench_bin() + "' run '" + suite + "' -o '" + dir + "' --no-plot > '" +
                   dir + ".out' 2>&1"),
@@ -140,6 +150,9 @@ TEST(Run, QuickSuiteEndToEnd) {
       EXPECT_EQ(r["brute_rays_checked"], r["ray_count"]);
     }
     EXPECT_TRUE(r["ratio_to_embree"].is_number());
+    EXPECT_TRUE(r["cpu_ratio_to_embree"].is_number());
+    EXPECT_GT(r["rays_per_cpu_second"].get<double>(), 0.0);
+    EXPECT_EQ(r["cpu_seconds_samples"].size(), r["seconds_samples"].size());
   }
   for (const auto& info : accelerators())
     if (info.name.rfind("test-", 0) != 0 && info.name != "cgal" && info.name != "bullet") {
@@ -149,12 +162,12 @@ TEST(Run, QuickSuiteEndToEnd) {
   const json gbench = json::parse(read_text(dir + "/gbench.json"));
   EXPECT_GT(gbench["benchmarks"].size(), report["results"].size());
   EXPECT_NE(read_text(dir + ".out").find("ratio@1"), std::string::npos);
-  fs::remove_all(dir);
 }
 
 TEST(Run, BadSuiteExitsTwoBeforeAnyWork) {
   if (test::accelbench_bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
-  const std::string dir = fresh_dir("bad");
+  const RunDir run_dir("bad");
+  const std::string& dir = run_dir.path;
   const std::string suite = dir + ".json";
   std::ofstream(suite) << R"({"scenes": [{"generator": "soup", "triangles": 100}],
     "accelerators": ["brute", "bvh-sah", "foo"], "rays": [{"kind": "primary", "count": 8}]})";
@@ -167,7 +180,8 @@ TEST(Run, BadSuiteExitsTwoBeforeAnyWork) {
 }
 
 TEST(Run, BrokenAcceleratorFailsTheRunLoudly) {
-  const std::string dir = fresh_dir("broken");
+  const RunDir run_dir("broken");
+  const std::string& dir = run_dir.path;
   const std::string suite = dir + ".json";
   std::ofstream(suite) << R"({"repetitions": 1, "warmup": 0, "threads": [1],
     "scenes": [{"generator": "sphereflake", "triangles": 500}],
@@ -196,12 +210,12 @@ TEST(Run, BrokenAcceleratorFailsTheRunLoudly) {
       EXPECT_GT(r["brute_mismatches"].get<int>() + r["reference_mismatches"].get<int>(), 0);
     }
   }
-  fs::remove_all(dir);
 }
 
 TEST(Run, InterruptKeepsFinishedCases) {
   if (test::accelbench_bin().empty()) GTEST_SKIP() << "ACCELBENCH_BIN is not set (run through ctest)";
-  const std::string dir = fresh_dir("interrupt");
+  const RunDir run_dir("interrupt");
+  const std::string& dir = run_dir.path;
   const std::string suite = dir + ".json";
   std::ofstream(suite) << R"({"repetitions": 3, "threads": [1], "min_time": 0.05,
     "scenes": [{"generator": "soup", "triangles": [300, 301, 302, 303, 304, 305, 306, 307]}],
@@ -230,7 +244,6 @@ TEST(Run, InterruptKeepsFinishedCases) {
   EXPECT_LT(report["scenes"].size(), 8u);
   EXPECT_TRUE(fs::exists(dir + "/report.csv"));
   EXPECT_TRUE(fs::exists(dir + "/gbench.json"));
-  fs::remove_all(dir);
 }
 
 }  // namespace

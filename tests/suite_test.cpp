@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "accel/core/error.h"
 #include "accel/core/registry.h"
@@ -345,6 +347,32 @@ TEST(Harness, GoogleBenchmarkTimingReportsMedianMinMax) {
   const json j = json::parse(timer.json());
   EXPECT_GE(j["benchmarks"].size(), 3u);
   EXPECT_NE(j["benchmarks"][0]["name"].get<std::string>().find("unit/test"), std::string::npos);
+}
+
+TEST(Harness, CpuTimeLeavesOutWaiting) {
+  // A pass that sleeps takes wall time but almost no cpu; a pass that spins takes both: the cpu figures are
+  // the process's work, not the time it spent off the cores.
+  BenchTimer timer;
+  auto timed = [](auto&& work) {
+    return [work] {
+      const auto t0 = std::chrono::steady_clock::now();
+      work();
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+  };
+  const Timing sleeping = timer.time(
+      "unit/sleep", 3, 1, timed([] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); }));
+  EXPECT_GE(sleeping.median, 0.019);
+  ASSERT_EQ(sleeping.cpu_samples.size(), 3u);
+  EXPECT_LT(sleeping.cpu_median, 0.25 * sleeping.median);
+  const Timing spinning =
+      timer.time("unit/spin", 3, 1, timed([] {
+                   const auto t0 = std::chrono::steady_clock::now();
+                   while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(20)) {
+                   }
+                 }));
+  EXPECT_GT(spinning.cpu_median, 0.0);
+  EXPECT_LE(spinning.cpu_median, 1.5 * spinning.median);
 }
 
 }  // namespace
