@@ -1,6 +1,6 @@
-// `accelbench compare BASE NEW [--threshold P] [--alpha A] [--json F] [--csv F]`: two runs (folders or
-// report.json files) case by case; exit 1 on a significant regression beyond the threshold, 0 otherwise, 2 on
-// bad input.
+// `accelbench compare BASE NEW [--threshold P] [--alpha A] [--cpu] [--json F] [--csv F]`: two runs (folders
+// or report.json files) case by case; exit 1 on a significant regression beyond the threshold, 0 otherwise, 2
+// on bad input.
 #include <iostream>
 #include <memory>
 
@@ -16,12 +16,13 @@ struct CompareArgs {
   double threshold_percent = 5.0;
   double alpha = 0.05;
   std::string json, csv;
+  bool cpu = false;
 };
 
 int run_compare(const CompareArgs& a) {
   const nlohmann::json base = load_run_report(a.base);
   const nlohmann::json next = load_run_report(a.next);
-  const RunComparison c = compare_runs(base, next, a.threshold_percent / 100.0, a.alpha);
+  const RunComparison c = compare_runs(base, next, a.threshold_percent / 100.0, a.alpha, a.cpu);
   print_comparison(std::cout, c);
   if (!a.json.empty())
     write_file_atomically(
@@ -43,6 +44,7 @@ const CommandRegistrar kCompare{
            ->check(CLI::Range(0.0, 1000.0));
        app.add_option("--alpha", a->alpha, "significance level of the Mann-Whitney U test (default 0.05)")
            ->check(CLI::Range(0.0, 1.0));
+       app.add_flag("--cpu", a->cpu, "compare queries by the process's cpu seconds (not wall seconds)");
        app.add_option("--json", a->json, "write the table as JSON");
        app.add_option("--csv", a->csv, "write the table as CSV");
        return [a] { return run_compare(*a); };

@@ -78,7 +78,7 @@ std::string scene_of(const json& r) {
   return r.contains("frame") ? scene + " frame " + r["frame"].dump() : scene;
 }
 
-std::vector<std::pair<std::string, Sample>> cases_of(const json& report) {
+std::vector<std::pair<std::string, Sample>> cases_of(const json& report, bool cpu) {
   std::vector<std::pair<std::string, Sample>> out;
   for (const json& r : report["results"]) {
     const std::string query = r.value("query", "");
@@ -89,8 +89,8 @@ std::vector<std::pair<std::string, Sample>> cases_of(const json& report) {
     s.id.rays = r.value("rays", "");
     s.id.query = query;
     s.id.threads = r.value("threads", 0);
-    s.median = r.value("seconds_median", 0.0);
-    s.seconds = numbers(r.value("seconds_samples", json()));
+    s.median = r.value(cpu ? "cpu_seconds_median" : "seconds_median", 0.0);
+    s.seconds = numbers(r.value(cpu ? "cpu_seconds_samples" : "seconds_samples", json()));
     out.emplace_back(case_key(s.id), s);
   }
   for (const json& b : report.value("builds", json::array())) {
@@ -152,10 +152,11 @@ void warn_if_different(const json& base, const json& next, const std::string& se
 
 }  // namespace
 
-RunComparison compare_runs(const json& base, const json& next, double threshold, double alpha) {
+RunComparison compare_runs(const json& base, const json& next, double threshold, double alpha, bool cpu) {
   RunComparison out;
   out.threshold = threshold;
   out.alpha = alpha;
+  out.cpu = cpu;
   warn_if_different(base, next, "machine",
                     {"cpu_model", "logical_cores", "tbb_default_concurrency", "hostname"}, "machines",
                     out.warnings);
@@ -164,7 +165,14 @@ RunComparison compare_runs(const json& base, const json& next, double threshold,
       base.value("suite", json()) != next.value("suite", json()))
     out.warnings.push_back("the runs come from different suites (" + base.value("suite_name", json()).dump() +
                            " vs " + next.value("suite_name", json()).dump() + ")");
-  const auto base_cases = cases_of(base), next_cases = cases_of(next);
+  const auto base_cases = cases_of(base, cpu), next_cases = cases_of(next, cpu);
+  for (const auto* cases : {&base_cases, &next_cases})
+    for (const auto& [key, s] : *cases)
+      if (cpu && s.id.query != "build" && s.median <= 0) {
+        out.warnings.push_back(std::string(cases == &base_cases ? "BASE" : "NEW") +
+                               " has no cpu times (a report from before they were kept): " + key);
+        break;
+      }
   std::map<std::string, const Sample*> in_next, in_base;
   for (const auto& [key, s] : next_cases) in_next.emplace(key, &s);
   for (const auto& [key, s] : base_cases) in_base.emplace(key, &s);
@@ -205,9 +213,9 @@ json to_json(const RunComparison& c) {
                      {"base_repetitions", x.base_repetitions},
                      {"new_repetitions", x.new_repetitions},
                      {"change", change_name(x.change)}});
-  return {{"threshold", c.threshold}, {"alpha", c.alpha}, {"regressed", c.regressed()},
-          {"warnings", c.warnings},   {"cases", cases},   {"only_in_base", c.only_base},
-          {"only_in_new", c.only_new}};
+  return {{"threshold", c.threshold},    {"alpha", c.alpha},         {"cpu", c.cpu},
+          {"regressed", c.regressed()},  {"warnings", c.warnings},   {"cases", cases},
+          {"only_in_base", c.only_base}, {"only_in_new", c.only_new}};
 }
 
 namespace {
@@ -238,8 +246,9 @@ std::string to_csv(const RunComparison& c) {
 
 void print_comparison(std::ostream& out, const RunComparison& c) {
   for (const std::string& w : c.warnings) out << "warning: " << w << "\n";
-  out << "ratio = NEW/BASE of the medians (rays/s for queries, seconds for builds); change beyond "
-      << c.threshold * 100 << "% and Mann-Whitney p < " << c.alpha << "\n";
+  out << "ratio = NEW/BASE of the medians (rays/s for queries" << (c.cpu ? " by cpu time" : "")
+      << ", seconds for builds); change beyond " << c.threshold * 100 << "% and Mann-Whitney p < " << c.alpha
+      << "\n";
   out << std::left << std::setw(64) << "case" << std::right << std::setw(12) << "base ms" << std::setw(12)
       << "new ms" << std::setw(8) << "ratio" << std::setw(9) << "p"
       << "  change\n";

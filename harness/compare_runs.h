@@ -45,14 +45,16 @@ struct RunComparison {
   std::vector<std::string> warnings;   ///< different machines, compilers or suites
   double threshold = 0.05;             ///< the relative change that counts
   double alpha = 0.05;                 ///< the significance level
+  bool cpu = false;                    ///< queries compared by cpu seconds instead of wall seconds
   /// True when any case regressed (significant, beyond the threshold).
   bool regressed() const;
 };
 
 /// Compares NEW against BASE: a case changes when its ratio is beyond 1 +- threshold (slower: throughput
-/// below 1 - threshold, build time above 1 + threshold) and the test gives p < alpha.
+/// below 1 - threshold, build time above 1 + threshold) and the test gives p < alpha. With `cpu`, queries
+/// are compared by the process's cpu seconds per pass (cpu_seconds_median/samples) instead of wall seconds.
 RunComparison compare_runs(const nlohmann::json& base, const nlohmann::json& next, double threshold,
-                           double alpha);
+                           double alpha, bool cpu = false);
 
 /// The word of a verdict ("unchanged", "improvement", "REGRESSION", "untested").
 std::string change_name(Change c);

@@ -63,6 +63,28 @@ TEST(CompareRuns, FindsASignificantRegressionBeyondTheThreshold) {
   EXPECT_TRUE(c.warnings.empty());
 }
 
+TEST(CompareRuns, CpuComparesTheCpuSeconds) {
+  // The wall clock says 20% slower (a loaded machine), the cpu seconds say unchanged: --cpu judges by these.
+  auto with_cpu = [](json r, const std::vector<double>& cpu) {
+    std::vector<double> sorted = cpu;
+    std::sort(sorted.begin(), sorted.end());
+    r["cpu_seconds_median"] = sorted[sorted.size() / 2];
+    r["cpu_seconds_samples"] = cpu;
+    return r;
+  };
+  const json base = report({with_cpu(row("bvh-sah", 1, kBase), kBase)}, kBase);
+  const json next = report({with_cpu(row("bvh-sah", 1, kSlower), kNoise)}, kBase);
+  EXPECT_TRUE(compare_runs(base, next, 0.05, 0.05).regressed());
+  const RunComparison c = compare_runs(base, next, 0.05, 0.05, true);
+  EXPECT_FALSE(c.regressed());
+  EXPECT_TRUE(c.warnings.empty());
+  EXPECT_NEAR(c.cases[0].ratio, 1.0, 0.02);
+  // A report without cpu times is named, not silently judged equal.
+  const RunComparison old = compare_runs(report({row("bvh-sah", 1, kBase)}, kBase), next, 0.05, 0.05, true);
+  ASSERT_EQ(old.warnings.size(), 1u);
+  EXPECT_NE(old.warnings[0].find("BASE has no cpu times"), std::string::npos);
+}
+
 TEST(CompareRuns, ImprovementsAndBuildRegressions) {
   const json base = report({row("bvh-sah", 1, kSlower)}, kBase);
   const json next = report({row("bvh-sah", 1, kBase)}, kSlower);
