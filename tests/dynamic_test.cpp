@@ -140,53 +140,67 @@ bool same_bytes(const A& a, const A& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
 }
 
+/// A B of the given width over base, built.
+template <class B>
+std::unique_ptr<B> built_bvh(const Mesh& base, int width) {
+  typename B::Config config;
+  config.width = width;
+  auto bvh = std::make_unique<B>(std::make_shared<TrianglePrims>(std::make_shared<Mesh>(base)), config);
+  bvh->build();
+  return bvh;
+}
+
+/// Refits a to frame sa at 1 thread and b to frame sb at 2 threads; both trees must be the same bytes.
+template <class B, class SA, class SB>
+void expect_same_refit(B& a, const SA& sa, B& b, const SB& sb) {
+  bool ok_a = false, ok_b = false;
+  tbb::task_arena(1).execute([&] { ok_a = a.refit(sa); });
+  tbb::task_arena(2).execute([&] { ok_b = b.refit(sb); });
+  ASSERT_TRUE(ok_a && ok_b);
+  ASSERT_TRUE(same_bytes(a.nodes(), b.nodes()));
+  ASSERT_TRUE(same_bytes(a.wide_nodes(), b.wide_nodes()));
+  ASSERT_TRUE(same_bytes(a.leaf_blocks(), b.leaf_blocks()));
+}
+
 /// Refitting straight from the frame's mesh (at 1 thread) gives the tree a refit from its TrianglePrims (at
 /// 2) gives, byte for byte, tight, with brute's hits; after it a rebuild and the quality metrics see the
 /// frame (its TrianglePrims made then), and a mesh of another triangle count is refused.
 template <class B>
 void check_refit_from_mesh(int width) {
   const Mesh base = generate_mesh("sphereflake", 3000, 1, {});
-  auto prims0 = std::make_shared<TrianglePrims>(std::make_shared<Mesh>(base));
-  typename B::Config config;
-  config.width = width;
-  B from_mesh(prims0, config), from_prims(prims0, config);
-  from_mesh.build(), from_prims.build();
+  const auto from_mesh = built_bvh<B>(base, width), from_prims = built_bvh<B>(base, width);
   // Refitted to the positions it was built over, the leaf blocks are the build's byte for byte (their terms,
   // made four lanes at once, are the bits the build's packing stores lane by lane).
-  const std::vector<Triangle4> built_blocks = from_mesh.leaf_blocks();
-  ASSERT_TRUE(from_mesh.refit(std::make_shared<const Mesh>(base)));
-  EXPECT_TRUE(same_bytes(from_mesh.leaf_blocks(), built_blocks));
+  const std::vector<Triangle4> built_blocks = from_mesh->leaf_blocks();
+  ASSERT_TRUE(from_mesh->refit(std::make_shared<const Mesh>(base)));
+  EXPECT_TRUE(same_bytes(from_mesh->leaf_blocks(), built_blocks));
   std::shared_ptr<const TrianglePrims> prims;
   for (Deformer::Kind kind : {Deformer::Kind::kWave, Deformer::Kind::kExplode})
     for (float p : {0.3f, 1.0f}) {
       const auto mesh = deformed(base, kind, p);
       prims = std::make_shared<TrianglePrims>(mesh);
-      bool ok_mesh = false, ok_prims = false;
-      tbb::task_arena(1).execute([&] { ok_mesh = from_mesh.refit(mesh); });
-      tbb::task_arena(2).execute([&] { ok_prims = from_prims.refit(prims); });
-      ASSERT_TRUE(ok_mesh && ok_prims);
-      ASSERT_TRUE(same_bytes(from_mesh.nodes(), from_prims.nodes()));
-      ASSERT_TRUE(same_bytes(from_mesh.wide_nodes(), from_prims.wide_nodes()));
-      if (width == 2) expect_tight_binary(from_mesh, *prims);
-      if (width == 8) expect_tight_wide(from_mesh, *prims);
-      EXPECT_EQ(from_mesh.bounds().lo, prims->bounds().lo);
-      EXPECT_EQ(from_mesh.bounds().hi, prims->bounds().hi);
+      expect_same_refit(*from_mesh, mesh, *from_prims, prims);
+      if (::testing::Test::HasFatalFailure()) return;
+      if (width == 2) expect_tight_binary(*from_mesh, *prims);
+      if (width == 8) expect_tight_wide(*from_mesh, *prims);
+      EXPECT_EQ(from_mesh->bounds().lo, prims->bounds().lo);
+      EXPECT_EQ(from_mesh->bounds().hi, prims->bounds().hi);
       auto brute = make_accelerator("brute", prims, {});
       brute->build();
       const std::vector<Ray> rays = rays_into(prims->bounds(), 1500);
       const std::vector<Hit> expected = hits_of(*brute, rays, 1);
       for (int threads : {1, 2})
-        EXPECT_TRUE(same_hits(hits_of(from_mesh, rays, threads), expected))
+        EXPECT_TRUE(same_hits(hits_of(*from_mesh, rays, threads), expected))
             << "width " << width << " p " << p;
     }
-  from_mesh.measure_quality(), from_prims.measure_quality();
-  EXPECT_EQ(from_mesh.stats().epo, from_prims.stats().epo);
-  from_mesh.build();  // over the last frame: its TrianglePrims is made from the mesh now
+  from_mesh->measure_quality(), from_prims->measure_quality();
+  EXPECT_EQ(from_mesh->stats().epo, from_prims->stats().epo);
+  from_mesh->build();  // over the last frame: its TrianglePrims is made from the mesh now
   auto brute = make_accelerator("brute", prims, {});
   brute->build();
   const std::vector<Ray> rays = rays_into(prims->bounds(), 1500, 7);
-  EXPECT_TRUE(same_hits(hits_of(from_mesh, rays, 2), hits_of(*brute, rays, 1)));
-  EXPECT_FALSE(from_mesh.refit(std::make_shared<const Mesh>()));
+  EXPECT_TRUE(same_hits(hits_of(*from_mesh, rays, 2), hits_of(*brute, rays, 1)));
+  EXPECT_FALSE(from_mesh->refit(std::make_shared<const Mesh>()));
 }
 
 TEST(Refit, FromTheMeshEqualsFromItsTrianglePrims) {
@@ -194,6 +208,46 @@ TEST(Refit, FromTheMeshEqualsFromItsTrianglePrims) {
     check_refit_from_mesh<BvhSah<TrianglePrims>>(width);
     check_refit_from_mesh<BvhMedian<TrianglePrims>>(width);
   }
+}
+
+/// Checks every interior lane box of a wide tree is exactly the union of its child node's lanes.
+template <class B>
+void expect_tight_wide_interior(const B& bvh) {
+  const Bvh8NodeArray& wide = bvh.wide_nodes();
+  for (const Bvh8Node& node : wide)
+    for (int k = 0; k < Bvh8Node::kWidth; ++k) {
+      if (node.count[k] != 0 || node.child[k] == 0) continue;
+      const AABB want = wide_node_box(wide[node.child[k]]);
+      ASSERT_EQ(node.box(k).lo, want.lo);
+      ASSERT_EQ(node.box(k).hi, want.hi);
+    }
+}
+
+/// The refit by parallel subtrees (refit.h: a serial descent picks subtrees of bounded size, a parallel loop
+/// refits each in one task, the nodes above them last) gives the serial refit's tree byte for byte on a tree
+/// of many tasks, every box the union of its triangles' or children's, and brute's hits.
+template <class B>
+void check_refit_by_subtrees(int width) {
+  const Mesh base = generate_mesh("sphereflake", 40000, 1, {});
+  const auto serial = built_bvh<B>(base, width), parallel = built_bvh<B>(base, width);
+  const size_t nodes = width == 8 ? parallel->wide_nodes().size() : parallel->nodes().size();
+  ASSERT_GT(nodes, 8 * (width == 8 ? kRefitTaskNodesWide : kRefitTaskNodesBinary));  // many tasks
+  for (Deformer::Kind kind : {Deformer::Kind::kWave, Deformer::Kind::kExplode}) {
+    const auto mesh = deformed(base, kind, 0.7f);
+    expect_same_refit(*serial, mesh, *parallel, mesh);
+    if (::testing::Test::HasFatalFailure()) return;
+    const auto prims = std::make_shared<TrianglePrims>(mesh);
+    if (width == 2) expect_tight_binary(*parallel, *prims);
+    if (width == 8) expect_tight_wide(*parallel, *prims), expect_tight_wide_interior(*parallel);
+    auto brute = make_accelerator("brute", prims, {});
+    brute->build();
+    const std::vector<Ray> rays = rays_into(prims->bounds(), 1000);
+    EXPECT_TRUE(same_hits(hits_of(*parallel, rays, 2), hits_of(*brute, rays, 1))) << "width " << width;
+  }
+}
+
+TEST(Refit, ByParallelSubtreesEqualsTheSerialRefit) {
+  for (int width : {2, 8}) check_refit_by_subtrees<BvhSah<TrianglePrims>>(width);
 }
 
 TEST(Refit, StructuresThatDoNotRefitSayFalse) {

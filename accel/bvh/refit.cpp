@@ -83,13 +83,30 @@ AABB copy_leaf_triangles(std::vector<Triangle>& tris, const std::vector<uint32_t
   return box;
 }
 
+/// The rows x, y, z of four points (x, y, z, 0 each): their transpose.
+[[gnu::always_inline]] inline Vec3T<Lanes4> rows_of(__m128 a, __m128 b, __m128 c, __m128 d) {
+  _MM_TRANSPOSE4_PS(a, b, c, d);
+  return {Lanes4(a), Lanes4(b), Lanes4(c)};
+}
+
+/// Stores one term of a block (its x, y and z rows).
+[[gnu::always_inline]] inline void store_term(float (&row)[3][4], const Vec3T<Lanes4>& term) {
+  _mm_store_ps(row[0], term.x.v);
+  _mm_store_ps(row[1], term.y.v);
+  _mm_store_ps(row[2], term.z.v);
+}
+
 /// Writes one block whose lanes j < m hold the triangles ids[0, m) (the rest the zero-area triangle, all
 /// terms zero, as pack_leaf_blocks leaves them) and folds their corners into lo and hi. The four triangles'
 /// corners are transposed into rows and their terms made on four lanes at once: triangle_terms' IEEE
-/// operations lane by lane, so the bits Triangle4::set_lane stores for each.
+/// operations lane by lane (e1 = v1 - v0, e2 = v2 - v0, n = cross(e1, e2) with triangle.h's operator- and
+/// cross), so the bits Triangle4::set_lane stores for each. The terms are composed here rather than taken
+/// as triangle_terms' TriangleTerms: GCC copies that returned aggregate through the stack with 32-byte moves
+/// over 16-byte stores, a store-forwarding stall that made this function a third of the refit's time (1M
+/// sphereflake, perf), while the terms in registers go straight to the block.
 template <class Corners>
-void write_block(Triangle4& block, const uint32_t* ids, uint32_t m, const Corners& corners, __m128& lo,
-                 __m128& hi) {
+[[gnu::always_inline]] inline void write_block(Triangle4& block, const uint32_t* ids, uint32_t m,
+                                               const Corners& corners, __m128& lo, __m128& hi) {
   __m128 q[4][3];  // q[lane][corner] = (x, y, z, 0)
   for (uint32_t j = 0; j < 4; ++j) {
     if (j >= m) {
@@ -99,19 +116,14 @@ void write_block(Triangle4& block, const uint32_t* ids, uint32_t m, const Corner
     corners.lanes(ids[j], q[j]);
     for (int c = 0; c < 3; ++c) lo = _mm_min_ps(lo, q[j][c]), hi = _mm_max_ps(hi, q[j][c]);
   }
-  Vec3T<Lanes4> v[3];
-  for (int c = 0; c < 3; ++c) {
-    __m128 x = q[0][c], y = q[1][c], z = q[2][c], w = q[3][c];
-    _MM_TRANSPOSE4_PS(x, y, z, w);  // rows x, y, z (and the zero row)
-    v[c] = {Lanes4(x), Lanes4(y), Lanes4(z)};
-  }
-  const TriangleTerms<Lanes4> terms = triangle_terms(v[0], v[1], v[2]);
-  const Vec3T<Lanes4>* rows[4] = {&terms.v0, &terms.e1, &terms.e2, &terms.n};
-  for (int r = 0; r < 4; ++r) {
-    _mm_store_ps(block.row[r][0], rows[r]->x.v);
-    _mm_store_ps(block.row[r][1], rows[r]->y.v);
-    _mm_store_ps(block.row[r][2], rows[r]->z.v);
-  }
+  const auto corner = [&](int c) { return rows_of(q[0][c], q[1][c], q[2][c], q[3][c]); };
+  const Vec3T<Lanes4> v0 = corner(0);
+  const Vec3T<Lanes4> e1 = corner(1) - v0;
+  const Vec3T<Lanes4> e2 = corner(2) - v0;
+  store_term(block.row[0], v0);
+  store_term(block.row[1], e1);
+  store_term(block.row[2], e2);
+  store_term(block.row[3], cross(e1, e2));
 }
 
 /// Writes the (count + 3) / 4 blocks of the wide leaf from block `first` on through `corners` and returns
