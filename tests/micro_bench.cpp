@@ -168,6 +168,8 @@ const std::vector<Ray>& rays_of(Workload& w, const std::string& kind) {
   return r;
 }
 
+/// One thread through the batch entry points: closest hit, or any hit for shadow rays (what the harness
+/// traces them with).
 void BM_Trace(benchmark::State& state, std::string generator, std::string kind, std::string accel,
               std::string param) {
   Workload& w = workload(generator);
@@ -176,10 +178,17 @@ void BM_Trace(benchmark::State& state, std::string generator, std::string kind, 
   if (!param.empty()) params.add(param);
   auto structure = make_target_accelerator(w.target, accel, params);
   structure->build();
-  std::vector<Hit> hits(rays.size());
+  const bool any_hit = kind == "shadow";
+  std::vector<Hit> hits(any_hit ? 0 : rays.size());
+  std::vector<uint8_t> occluded(any_hit ? rays.size() : 0);
   for (auto _ : state) {
-    structure->intersect(rays, hits);  // one thread: the batch entry point
-    benchmark::DoNotOptimize(hits.data());
+    if (any_hit) {
+      structure->occluded(rays, occluded);
+      benchmark::DoNotOptimize(occluded.data());
+    } else {
+      structure->intersect(rays, hits);
+      benchmark::DoNotOptimize(hits.data());
+    }
   }
   state.SetItemsProcessed(int64_t(state.iterations() * rays.size()));
   state.counters["Mrays/s"] =
@@ -214,6 +223,11 @@ const bool kRegistered = [] {
                                      BM_Trace, g, kind, accel, "")
             ->Unit(benchmark::kMillisecond)
             ->MinWarmUpTime(0.2);
+    for (const char* accel : {"bvh-sah", "embree"})  // any hit
+      benchmark::RegisterBenchmark((std::string("BM_Trace/") + g + "/shadow/" + accel).c_str(), BM_Trace, g,
+                                   "shadow", accel, "")
+          ->Unit(benchmark::kMillisecond)
+          ->MinWarmUpTime(0.2);
     for (const char* kind : {"primary", "incoherent"})
       for (const char* cost : {"0.5", "2", "3"})
         benchmark::RegisterBenchmark(
