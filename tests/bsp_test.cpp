@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include "datasets/generators.h"
 #include "structure_test_helpers.h"
 
 namespace ab {
@@ -116,6 +117,95 @@ TEST(BspCell, APlaneThatDoesNotCutLeavesTheCellWhole) {
   surface.areas(diagonal.n, d, &below, &above);
   EXPECT_FLOAT_EQ(below, surface.area());
   EXPECT_EQ(above, 0.0f);
+}
+
+TEST(BspCell, ABoxCutByAxisPlanesStaysABoxWithTheCellSurfacesAreas) {
+  const AABB b{{0, 0, 0}, {1, 2, 3}};
+  const ConvexCell box = ConvexCell::from_box(b);
+  const ConvexCell half = box.part(BspPlane{{0, 1, 0}, 0.5f}, false);
+  ASSERT_TRUE(half.is_box());
+  EXPECT_EQ(half.bounds().lo, vec3(0, 0.5f, 0));
+  EXPECT_EQ(half.bounds().hi, b.hi);
+  EXPECT_FALSE(box.part(BspPlane{glm::normalize(vec3(1, 1, 0)), 1.0f}, true).is_box());
+  // A normal whose x rounds to 1 is still oblique: the cell is clipped as a polyhedron.
+  EXPECT_FALSE(box.part(BspPlane{vec3(1.0f, 1e-4f, 0.0f), 0.5f}, true).is_box());
+  const CellSurface surface(half);
+  const BoxSurface closed(half.bounds());
+  EXPECT_NEAR(closed.area(), surface.area(), 1e-5f);
+  for (int a = 0; a < 3; ++a) {
+    vec3 n(0.0f);
+    n[a] = 1.0f;
+    float lo, hi, box_lo, box_hi;
+    surface.extent(n, lo, hi);
+    closed.extent(n, box_lo, box_hi);
+    EXPECT_EQ(lo, box_lo);
+    EXPECT_EQ(hi, box_hi);
+    const float d[5] = {lo, lo + 0.1f * (hi - lo), lo + 0.5f * (hi - lo), lo + 0.9f * (hi - lo), hi};
+    float below[5], above[5], box_below[5], box_above[5];
+    surface.areas(n, d, below, above);
+    closed.areas(n, d, box_below, box_above);
+    for (int k = 0; k < 5; ++k) {
+      EXPECT_NEAR(box_below[k], below[k], 1e-4f) << a << " " << k;
+      EXPECT_NEAR(box_above[k], above[k], 1e-4f) << a << " " << k;
+    }
+  }
+}
+
+TEST(Bsp, TheBudgetedAttemptTakesTheFirstAttemptsDecisions) {
+  // Large overlapping triangles pass a budget of 4 references per triangle: the second attempt takes the
+  // first one's decisions (reuse_decisions), which must give the tree it makes without them, at any
+  // thread count (the first attempt reaches other nodes before it is abandoned).
+  const Mesh mesh = generate_mesh("large", 1500, 3, Params());
+  auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
+  const std::vector<Ray> rays = adversarial_rays(mesh, 1500, 14);
+  auto build = [&](bool reuse, int threads, std::vector<Hit>& hits) {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    BspConfig config;
+    config.ref_budget = 4.0;
+    config.reuse_decisions = reuse;
+    BspTree<TrianglePrims> tree(prims, config);
+    tree.build();
+    hits.resize(rays.size());
+    tree.intersect(rays, hits);
+    return tree.stats();
+  };
+  std::vector<Hit> without, with1, with2;
+  const BuildStats base = build(false, 1, without);
+  EXPECT_EQ(base.extra.at("budget_exhausted"), true);
+  EXPECT_LE(base.references, 4 * base.primitives);
+  for (auto* hits : {&with1, &with2}) {
+    const BuildStats s = build(true, hits == &with1 ? 1 : 2, *hits);
+    EXPECT_EQ(s.nodes, base.nodes);
+    EXPECT_EQ(s.references, base.references);
+    EXPECT_EQ(s.max_depth, base.max_depth);
+    EXPECT_EQ(s.leaf_size_histogram, base.leaf_size_histogram);
+    EXPECT_EQ(s.extra.at("oblique_planes"), base.extra.at("oblique_planes"));
+    EXPECT_EQ(0, std::memcmp(hits->data(), without.data(), without.size() * sizeof(Hit)));
+  }
+  EXPECT_EQ(count_differences("bsp", mesh, rays, {{"ref_budget", "4"}}), 0u);
+}
+
+TEST(Bsp, SplitsThatShrinkAFansCentreAreNoShaves) {
+  // Every triangle of a fan meets its centre, so every plane keeps nearly all of them on the centre's
+  // side: as shaves they stop after bad_refines, leaving a large leaf at the centre; splits that shrink
+  // the cell (shave_area) go on.
+  const Mesh mesh = generate_mesh("fan", 1500, 5, Params());
+  std::mt19937 rng(15);
+  std::vector<Ray> rays(2000);  // from outside the fan towards points in its cube, as a camera's
+  for (Ray& r : rays) {
+    const vec3 to(uniform(rng, 0.0f, 1.0f), uniform(rng, 0.0f, 1.0f), uniform(rng, 0.0f, 1.0f));
+    r.org =
+        vec3(0.5f) + 2.0f * glm::normalize(vec3(uniform(rng, -1.0f, 1.0f), uniform(rng, -1.0f, 1.0f), 1.0f));
+    r.dir = to - r.org;
+  }
+  auto tests = [&](std::map<std::string, std::string> params) {
+    std::vector<Hit> hits(rays.size());
+    RayCounters c;
+    built("bsp", mesh, std::move(params))->intersect_counted(rays, hits, c);
+    return c.prims;
+  };
+  EXPECT_LT(4 * tests({}), tests({{"shave_area", "0"}}));
+  EXPECT_EQ(count_differences("bsp", mesh, rays), 0u);
 }
 
 TEST(Bsp, MatchesBruteOnObliqueGeometryAndRaysInObliquePlanes) {

@@ -35,13 +35,22 @@ class BspBuilder {
 
   /// Builds over ids (finite bounds) inside box into out.
   void build(std::vector<uint32_t> ids, const AABB& box, BspBuffer& out) const {
+    BspBuffer first;  // the abandoned first attempt's nodes and planes: the second attempt's memo
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
+      if (!ledger && config_.reuse_decisions) {
+        first = std::move(out);
+        first.refs = {};
+        memo_ = &first;
+      }
       out = BspBuffer{};
-      build_node(gather_root(ids, box), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, out);
+      NodePrims root = gather_root(ids, box);
+      if (ledger) ledger->add_leaf(root.size());
+      build_node(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, 0, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;
+    memo_ = nullptr;
   }
   /// True when the tree was built with the reference budget (build_with_budget).
   bool budget_exhausted() const { return budget_exhausted_; }
@@ -161,16 +170,52 @@ class BspBuilder {
     return {};
   }
 
+  /// The first attempt's tree as the memo of the budgeted second attempt (build_with_budget): a node's
+  /// decision depends only on its primitives, cell and depth, never on its budget, which only turns a split
+  /// into a leaf, so both attempts take the same paths down to the first node the budget stops, and the
+  /// second takes each decision the first one made (an interior node: its plane; a leaf: a leaf) instead of
+  /// evaluating the candidates again, which is most of a node's cost. Nodes the first attempt abandoned
+  /// (kAbandoned) and those below it are decided again. The same tree as without the memo, for any thread
+  /// count (a remembered decision is the one decide gives, whichever nodes the first attempt reached).
+  Decision memoized_decision(const NodePrims& np, const ConvexCell& cell, const Depth& depth,
+                             uint32_t at) const {
+    if (memo_ && at != kNoMemo) {
+      const BspNode& m = memo_->nodes[at];
+      if (!m.is_leaf()) return {memo_->payload[m.plane()], true, false};
+      if (m.count() != kAbandoned.count()) return {};
+    }
+    return decide(np, cell, depth);
+  }
+  /// The memo node of child `above` (0 below, 1 above) of memo node at (kNoMemo: none).
+  uint32_t memo_child(uint32_t at, int above) const {
+    if (!memo_ || at == kNoMemo || memo_->nodes[at].is_leaf()) return kNoMemo;
+    return above ? memo_->nodes[at].above() : at + 1;
+  }
+  static constexpr uint32_t kNoMemo = ~0u;
+  /// The node an abandoned first attempt writes where it stopped (no real leaf holds 2^31 - 1 references).
+  static inline const BspNode kAbandoned = BspNode::leaf(0, (1u << 31) - 1);
+
   /// Appends a leaf of the node's primitives.
-  void make_leaf(const NodePrims& np, BspBuffer& out) const {
-    if (ledger_) ledger_->add_leaf(np.size());
-    out.nodes.push_back(out.make_leaf(np.ids));
+  void make_leaf(const NodePrims& np, BspBuffer& out) const { out.nodes.push_back(out.make_leaf(np.ids)); }
+
+  /// Counts a split into the first attempt's ledger. Its leaf count is the references of the frontier (the
+  /// root's, and each split's children's beyond their parent's), not of the leaves made so far: the same
+  /// sum when the tree is done (at least the leaves' references: a child drops the primitives whose part
+  /// misses its cell), but it only grows, and passes ref_budget x N as soon as the splits made so far have
+  /// copied that many, so a tree over the budget is abandoned after its first few duplicating levels
+  /// (large overlapping triangles: every split copies most of them) instead of after ref_budget x N
+  /// references of finished leaves. Whether it passes is still a property of the tree alone.
+  void count_split(size_t n, size_t nl, size_t nr) const {
+    if (!ledger_) return;
+    ledger_->add_children(nl + nr);
+    ledger_->add_leaf(nl + nr > n ? nl + nr - n : 0);
   }
 
-  void build_node(NodePrims&& np, const ConvexCell& cell, Depth depth, BspBuffer& out) const {
-    if (ledger_ && ledger_->over()) return;  // an abandoned attempt
+  /// Builds the node of primitives np in cell into out; `at`: its node in the memo (memoized_decision).
+  void build_node(NodePrims&& np, const ConvexCell& cell, Depth depth, uint32_t at, BspBuffer& out) const {
+    if (ledger_ && ledger_->over()) return out.nodes.push_back(kAbandoned);
     const size_t n = np.size();
-    const Decision d = decide(np, cell, depth);
+    const Decision d = memoized_decision(np, cell, depth, at);
     std::vector<uint8_t> sides;
     size_t nl = 0, nr = 0;
     if (d.split) classify(np, d.plane, sides, nl, nr);
@@ -178,12 +223,13 @@ class BspBuilder {
         !depth.budget.allows(nl + nr)) {
       return make_leaf(np, out);
     }
-    if (ledger_) ledger_->add_children(nl + nr);
+    count_split(n, nl, nr);
     const ConvexCell lcell = cell.part(d.plane, true), rcell = cell.part(d.plane, false);
     NodePrims left = child_prims(np, sides, 1, d.plane, lcell);
     NodePrims right = child_prims(np, sides, 2, d.plane, rcell);
     np = NodePrims{};
-    const bool shave = is_shave(nl, nr, n);
+    const bool shave =
+        is_shave(nl, nr, n, !d.forced, [&] { return (nl >= nr ? lcell : rcell).area() / cell.area(); });
     const int levels = depth.levels + 1, splits = depth.splits + int(nl > 0 && nr > 0);
     const int shaves = depth.shaves + int(shave);
     const Depth lnext{levels, splits, shaves, depth.budget.share(nl, nl + nr)};
@@ -192,17 +238,18 @@ class BspBuilder {
     const uint32_t plane = uint32_t(out.payload.size());
     out.payload.push_back(d.plane);
     out.nodes.push_back(BspNode::leaf(0, 0));
+    const uint32_t lat = memo_child(at, 0), rat = memo_child(at, 1);
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lnext, lb); },
-                           [&] { build_node(std::move(right), rcell, rnext, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lnext, lat, lb); },
+                           [&] { build_node(std::move(right), rcell, rnext, rat, rb); });
       out.append(lb);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lcell, lnext, out);
+      build_node(std::move(left), lcell, lnext, lat, out);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rcell, rnext, out);
+      build_node(std::move(right), rcell, rnext, rat, out);
     }
   }
 
@@ -243,9 +290,18 @@ class BspBuilder {
   /// a refinement that does not reduce the work), and a node of more than kFreeShaveSize primitives whose
   /// path already holds bad_refines - 1 of them considers none. Splits that peel off a cluster of the
   /// node's own (the 100k stadium's) are not shaves.
-  static bool is_shave(size_t nl, size_t nr, size_t n) {
+  ///
+  /// Except (shave_area) a split the SAH prices below the leaf whose larger child keeps at most shave_area
+  /// of the cell's surface area: it shrinks the cell of nearly all the primitives instead of cutting a
+  /// corner off it, so the larger child is hit by fewer rays. At a fan's centre, where every triangle meets
+  /// the shared vertex, every plane keeps nearly all on the vertex's side, and only such splits shrink the
+  /// cell around it (200k `fan`: leaves of 25-30k triangles at the vertex, 5,224 tests per ray). `share`
+  /// gives the larger child's area share (evaluated only for such a split).
+  template <class Share>
+  bool is_shave(size_t nl, size_t nr, size_t n, bool below_leaf, Share&& share) const {
     const size_t small = std::min(nl, nr), both = nl + nr > n ? nl + nr - n : 0;
-    return small > 0 && double(std::max(nl, nr)) > kShaveShare * double(n) && 2 * both > small;
+    if (!(small > 0 && double(std::max(nl, nr)) > kShaveShare * double(n) && 2 * both > small)) return false;
+    return !(below_leaf && config_.shave_area > 0.0f && share() <= config_.shave_area);
   }
   /// A split whose larger child keeps more than this share of the node's primitives is a shave.
   static constexpr double kShaveShare = 0.9;
@@ -253,10 +309,14 @@ class BspBuilder {
   /// 10k sphereflake 9% more triangle tests per ray).
   static constexpr size_t kFreeShaveSize = 64;
 
-  /// Keeps plane at cost c in the choices (nl and nr primitives below and above, of n).
-  static void keep(Choices& ch, const BspPlane& plane, float c, size_t nl, size_t nr, size_t n,
-                   bool shave_ok) {
-    if (!shave_ok && is_shave(nl, nr, n)) return;
+  /// Keeps plane at cost c in the choices (nl and nr primitives below and above, of n; al and ar the areas
+  /// of its parts).
+  void keep(Choices& ch, const BspPlane& plane, const CellArea& cell, float al, float ar, size_t nl,
+            size_t nr, size_t n, bool shave_ok) const {
+    const float c = cost(cell, al, ar, nl, nr);
+    if (!shave_ok &&
+        is_shave(nl, nr, n, c < config_.costs.leaf(n), [&] { return (nl >= nr ? al : ar) * cell.inv; }))
+      return;
     if (c < ch.best.cost) ch.best = {plane, c};
     if (nl < n && nr < n && c < ch.progress.cost) ch.progress = {plane, c};
   }
@@ -271,6 +331,14 @@ class BspBuilder {
     thread_local PlaneScratch kept;
     PlaneScratch own;
     PlaneScratch& scratch = np.size() <= kKeptScratchMax ? kept : own;
+    if (large && cell.is_box()) {  // a box cell cut by axis planes: the k-d tree's closed-form areas
+      const BoxSurface box(cell.bounds());
+      const float area = box.area();
+      if (!(area > 0.0f)) return ch;
+      for (size_t i = 0; i < 3; ++i)
+        binned_planes(np, box, CellArea{area, 1.0f / area}, bsp_directions()[i], shave_ok, scratch, ch);
+      return ch;
+    }
     surface.assign(cell);
     const float area = surface.area();
     if (!(area > 0.0f)) return ch;
@@ -315,8 +383,7 @@ class BspBuilder {
         }
       }
       for (int m = 0; m < 3; ++m)
-        keep(ch, BspPlane{own.n, d[m]}, cost(cell_area, al[m], ar[m], nl[m], nr[m]), nl[m], nr[m], np.size(),
-             shave_ok);
+        keep(ch, BspPlane{own.n, d[m]}, cell_area, al[m], ar[m], nl[m], nr[m], np.size(), shave_ok);
     }
   }
 
@@ -331,9 +398,10 @@ class BspBuilder {
   /// a larger node the bin boundaries of the extents (Wald 2007's binning, a primitive counted on every side
   /// its extent reaches) and two planes just outside all extents. A plane with an empty side must cut off at
   /// least 1/bins of the cell's extent, or each node would shave off another sliver (its primitives clipped a
-  /// little tighter) down to the depth limit.
-  void binned_planes(const NodePrims& np, const CellSurface& surface, const CellArea& cell_area,
-                     const vec3& dir, bool shave_ok, PlaneScratch& s, Choices& ch) const {
+  /// little tighter) down to the depth limit. Surface: the cell's (CellSurface) or a box cell's (BoxSurface).
+  template <class Surface>
+  void binned_planes(const NodePrims& np, const Surface& surface, const CellArea& cell_area, const vec3& dir,
+                     bool shave_ok, PlaneScratch& s, Choices& ch) const {
     const size_t n = np.size();
     std::vector<float>&lo = s.lo, &hi = s.hi, &d = s.d, &al = s.al, &ar = s.ar;
     std::vector<uint32_t>&nl = s.nl, &nr = s.nr;
@@ -367,7 +435,7 @@ class BspBuilder {
     for (size_t j = 0; j < d.size(); ++j) {
       if (nl[j] == 0 && !(d[j] - cell_lo >= min_gap)) continue;
       if (nr[j] == 0 && !(cell_hi - d[j] >= min_gap)) continue;
-      keep(ch, BspPlane{dir, d[j]}, cost(cell_area, al[j], ar[j], nl[j], nr[j]), nl[j], nr[j], n, shave_ok);
+      keep(ch, BspPlane{dir, d[j]}, cell_area, al[j], ar[j], nl[j], nr[j], n, shave_ok);
     }
   }
 
@@ -459,6 +527,8 @@ class BspBuilder {
   int depth_limit_;                      ///< resolved depth limit (> 0)
   float margin_;                         ///< insertion margin (from the root box)
   mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
+  /// The first attempt's tree, during the second (memoized_decision).
+  mutable const BspBuffer* memo_ = nullptr;
   mutable bool budget_exhausted_ = false;
 };
 

@@ -33,6 +33,14 @@ inline bool is_oblique(const BspPlane& p) {
   return !(p.n.x == 1.0f || p.n.y == 1.0f || p.n.z == 1.0f);
 }
 
+/// The axis of a plane whose normal is exactly an axis (0, 1, 2), else -1. (A normal whose other components
+/// are tiny but not zero can still round to a component of exactly 1, as is_oblique sees it.)
+inline int exact_axis(const BspPlane& p) {
+  for (int a = 0; a < 3; ++a)
+    if (p.n[a] == 1.0f && p.n[(a + 1) % 3] == 0.0f && p.n[(a + 2) % 3] == 0.0f) return a;
+  return -1;
+}
+
 /// The 13 fixed directions (unit length).
 inline const std::array<vec3, 13>& bsp_directions() {
   static const std::array<vec3, 13> dirs = [] {

@@ -28,8 +28,12 @@ class ConvexCell {
     const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
                              {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
     for (const auto& q : quads) c.faces_.push_back({corner(q[0]), corner(q[1]), corner(q[2]), corner(q[3])});
+    c.box_ = true;
     return c;
   }
+
+  /// True when the cell is its bounding box (the root's, cut by axis planes only).
+  bool is_box() const { return box_; }
 
   /// Surface area.
   float area() const {
@@ -93,6 +97,12 @@ class ConvexCell {
       }
     if (!keeps) return ConvexCell{};
     if (!removes) return *this;
+    if (const int a = exact_axis(p); box_ && a >= 0) {
+      // A box cut by an axis plane is a box: the k-d tree's split of the box instead of a polyhedron clip.
+      AABB b = bounds();
+      (below ? b.hi : b.lo)[a] = p.d;
+      return from_box(b);
+    }
     ConvexCell out;
     std::vector<vec3> cut;
     for (const auto& f : faces_) {
@@ -168,6 +178,52 @@ class ConvexCell {
   }
 
   std::vector<std::vector<vec3>> faces_;
+  bool box_ = false;  ///< the faces are those of an axis-aligned box (from_box)
+};
+
+/// The areas of a box cell cut by axis planes, in closed form (the k-d tree's SAH areas): the same
+/// interface as CellSurface (extent, areas along one of the three axes) for the nodes above oblique_max,
+/// whose cells are boxes, without triangulating the cell's surface.
+class BoxSurface {
+ public:
+  /// The surface of box b.
+  explicit BoxSurface(const AABB& b) : box_(b) {
+    for (const vec3& v : {b.lo, b.hi}) tol_ = std::max(tol_, 1e-6f * (1.0f + glm::length(v)));
+  }
+
+  /// Surface area.
+  float area() const { return box_.area(); }
+  /// The box's extent [lo, hi] along axis n.
+  void extent(const vec3& n, float& lo, float& hi) const {
+    const int a = axis(n);
+    lo = box_.lo[a];
+    hi = box_.hi[a];
+  }
+  /// Areas of the boxes below and above each plane dot(n, x) = d[k] along axis n; a plane within
+  /// rounding of the box's extent does not cut it (one part gets zero area), as CellSurface::areas.
+  void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
+    const int a = axis(n), b = (a + 1) % 3, c = (a + 2) % 3;
+    const vec3 e = box_.hi - box_.lo;
+    const float caps = 2.0f * e[b] * e[c], ring = 2.0f * (e[b] + e[c]), total = area();
+    for (size_t k = 0; k < d.size(); ++k) {
+      const float t = d[k] - box_.lo[a];
+      if (!(d[k] > box_.lo[a] + tol_)) {
+        below[k] = 0.0f;
+        above[k] = total;
+      } else if (!(d[k] < box_.hi[a] - tol_)) {
+        below[k] = total;
+        above[k] = 0.0f;
+      } else {
+        below[k] = caps + ring * t;
+        above[k] = caps + ring * (e[a] - t);
+      }
+    }
+  }
+
+ private:
+  static int axis(const vec3& n) { return n.x != 0.0f ? 0 : (n.y != 0.0f ? 1 : 2); }
+  AABB box_;
+  float tol_ = 0.0f;  ///< rounding band of a plane at the box's faces (as CellSurface)
 };
 
 /// The cell's surface as triangles, for evaluating many planes of one direction at once. The area of a
