@@ -30,8 +30,9 @@ inline nlohmann::json without_timings(nlohmann::json value) {
   for (auto it = value.begin(); it != value.end();) {
     const std::string& k = it.key();
     const bool timing = k.find("seconds") != std::string::npos ||
-                        k.find("rays_per_second") != std::string::npos || k == "ratio_to_embree" ||
-                        k == "iterations" || k == "extra" || k.find("peak_bytes") != std::string::npos;
+                        k.find("rays_per_second") != std::string::npos || k == "rays_per_cpu_second" ||
+                        k.find("ratio_to_embree") != std::string::npos || k == "iterations" || k == "extra" ||
+                        k.find("peak_bytes") != std::string::npos;
     if (timing)
       it = value.erase(it);
     else
