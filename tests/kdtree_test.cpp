@@ -1,5 +1,6 @@
 // k-d trees (kdtree-median, kdtree-sah): node encoding, the plane step, flat geometry lying in split
-// planes, rays lying in split planes, statistics, thread-count independence and parameter checks.
+// planes, rays lying in split planes, statistics, thread-count independence, kdtree-sah's binned nodes and
+// parameter checks.
 #include "accel/kdtree/kdtree.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include "accel/common/empty_leaves.h"
 #include "accel/common/split_plane.h"
 #include "accel/kdtree/node.h"
+#include "datasets/generators.h"
 #include "structure_test_helpers.h"
 
 namespace ab {
@@ -193,6 +195,16 @@ TEST(SplitPlane, CrossingRaysGetWidenedHalves) {
   EXPECT_FALSE(early.visit_second);
 }
 
+/// adversarial_mesh(k) with a random soup of `soup_size` triangles (seed) appended.
+Mesh adversarial_with_soup(int k, size_t soup_size, uint32_t seed) {
+  Mesh mesh = adversarial_mesh(k);
+  const Mesh soup = random_soup(soup_size, seed);
+  const uint32_t base = uint32_t(mesh.vertices.size());
+  mesh.vertices.insert(mesh.vertices.end(), soup.vertices.begin(), soup.vertices.end());
+  for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
+  return mesh;
+}
+
 TEST(KdTree, MatchesBruteOnFlatGeometryInSplitPlanes) {
   const Mesh mesh = axis_planes(4);
   std::vector<Ray> rays = in_plane_rays(4, 1500, 11);
@@ -208,11 +220,7 @@ TEST(KdTree, MatchesBruteOnFlatGeometryInSplitPlanes) {
 }
 
 TEST(KdTree, MatchesBruteOnAdversarialMeshesAndInstances) {
-  Mesh mesh = adversarial_mesh(6);
-  const Mesh soup = random_soup(300, 5);
-  const uint32_t base = uint32_t(mesh.vertices.size());
-  mesh.vertices.insert(mesh.vertices.end(), soup.vertices.begin(), soup.vertices.end());
-  for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
+  Mesh mesh = adversarial_with_soup(6, 300, 5);
   mesh.vertices.push_back({std::nanf(""), 0.0f, 0.0f});  // a triangle with a NaN vertex keeps its id
   mesh.triangles.push_back({0u, 1u, uint32_t(mesh.vertices.size() - 1)});
   const std::vector<Ray> rays = adversarial_rays(mesh, 3000, 21);
@@ -226,11 +234,7 @@ TEST(KdTree, MatchesBruteOnAdversarialMeshesAndInstances) {
 }
 
 TEST(KdTree, LeafCopiesOnOrOffGiveTheSameHitsAsBrute) {
-  Mesh mesh = adversarial_mesh(5);
-  const Mesh soup = random_soup(400, 6);
-  const uint32_t base = uint32_t(mesh.vertices.size());
-  mesh.vertices.insert(mesh.vertices.end(), soup.vertices.begin(), soup.vertices.end());
-  for (glm::uvec3 t : soup.triangles) mesh.triangles.push_back(t + glm::uvec3(base));
+  const Mesh mesh = adversarial_with_soup(5, 400, 6);
   const std::vector<Ray> rays = adversarial_rays(mesh, 2000, 22);
   for (const char* name : {"kdtree-sah", "kdtree-median", "bsp", "octree"})
     for (const char* copies : {"off", "on"})
@@ -326,6 +330,29 @@ TEST(KdTree, SameTreeForOneAndTwoThreads) {
     EXPECT_EQ(one.sah_cost, two.sah_cost) << name;
     EXPECT_EQ(0, std::memcmp(h1.data(), h2.data(), h1.size() * sizeof(Hit))) << name;
   }
+}
+
+TEST(KdTree, SahBinnedNodesMatchBruteAndCostAboutAsMuchAsTheExactSweep) {
+  // exact_max 0: every node chooses a binned plane and partitions clipped boxes (sah_bins.h).
+  const Mesh planes = axis_planes(4);
+  EXPECT_EQ(count_differences("kdtree-sah", planes, in_plane_rays(4, 1500, 13), {{"exact_max", "0"}}), 0u);
+  const Mesh mesh = adversarial_with_soup(5, 1500, 7);
+  const std::vector<Ray> rays = adversarial_rays(mesh, 2000, 24);
+  for (const char* exact_max : {"0", "64"})
+    EXPECT_EQ(count_differences("kdtree-sah", mesh, rays, {{"exact_max", exact_max}}), 0u) << exact_max;
+  for (const char* gen : {"large", "fan", "needles", "coplanar", "far", "mixed"}) {
+    const Mesh hostile = generate_mesh(gen, 1500, 2, Params());
+    EXPECT_EQ(
+        count_differences("kdtree-sah", hostile, adversarial_rays(hostile, 800, 5), {{"exact_max", "32"}}),
+        0u)
+        << gen;
+  }
+  // Binned top levels (from 256 triangles) cost about as much as the exact sweep's tree.
+  const Mesh dense = random_soup(8000, 29, 0.01f);
+  const double exact = built("kdtree-sah", dense, {{"exact_max", "100000"}})->stats().sah_cost;
+  const double binned = built("kdtree-sah", dense, {{"exact_max", "256"}})->stats().sah_cost;
+  EXPECT_LT(binned, 1.05 * exact);
+  EXPECT_GT(binned, 0.9 * exact);
 }
 
 TEST(KdTree, RejectsUnknownAndOutOfRangeParameters) {

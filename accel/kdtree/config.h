@@ -54,6 +54,9 @@ struct KdSahConfig {
   size_t max_leaf = 64;
   double ref_budget =
       32.0;  ///< the leaves hold at most this many references per primitive (build_with_budget)
+  /// Nodes holding more primitives than this choose their plane from bins (sah_bins.h), the others by the
+  /// exact event sweep (sah_sweep.h).
+  size_t exact_max = 8192;
 
   /// Reads every field from params.
   static KdSahConfig read(Params& params) {
@@ -65,6 +68,7 @@ struct KdSahConfig {
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
     params.read("max_leaf", c.max_leaf, 0, size_t(1) << 30);
     params.read("ref_budget", c.ref_budget, 1.0, 1e6);
+    params.read("exact_max", c.exact_max, 0, size_t(1) << 32);
     return c;
   }
 };

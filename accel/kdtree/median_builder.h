@@ -19,6 +19,7 @@
 
 #include "accel/common/conservative_insertion.h"
 #include "accel/common/refine_rules.h"
+#include "accel/kdtree/box_node.h"
 #include "accel/kdtree/config.h"
 #include "accel/kdtree/node.h"
 
@@ -28,12 +29,6 @@ namespace ab {
 template <class P>
 class KdMedianBuilder {
  public:
-  /// A primitive in a node: its id and its bounds clipped to the node box.
-  struct Ref {
-    uint32_t id;  ///< primitive id
-    AABB cb;      ///< its bounds clipped to the node box
-  };
-
   /// Builder over prims with the tree's configuration and its resolved depth limit (> 0).
   KdMedianBuilder(const P& prims, const KdMedianConfig& config, int depth_limit)
       : prims_(prims), config_(config), depth_limit_(depth_limit) {}
@@ -43,9 +38,7 @@ class KdMedianBuilder {
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = KdBuffer{};
-      std::vector<Ref> refs(ids.size());
-      for (size_t i = 0; i < ids.size(); ++i) refs[i] = {ids[i], prims_.clipped_bounds(ids[i], box)};
-      build_node(std::move(refs), box, {0, 0, budget}, out);
+      build_node(make_box_root(prims_, ids, box), {0, 0, budget}, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;
@@ -75,82 +68,56 @@ class KdMedianBuilder {
     return !path.budget.allows(nl + nr);
   }
 
-  void build_node(std::vector<Ref>&& refs, const AABB& box, Path path, KdBuffer& out) const {
+  void build_node(KdBoxNode&& node, Path path, KdBuffer& out) const {
     if (ledger_ && ledger_->over()) return;  // an abandoned attempt
-    const size_t n = refs.size();
+    const size_t n = node.ids.size();
     const int depth = path.depth;
-    int axis = config_.axis == KdAxisRule::kCycle ? depth % 3 : box.longest_axis();
+    const int axis = config_.axis == KdAxisRule::kCycle ? depth % 3 : node.box.longest_axis();
     float split = 0.0f;
-    if (n <= config_.leaf_size || depth >= depth_limit_ || !median_plane(refs, box, axis, split)) {
-      make_leaf(refs, out);
-      return;
-    }
-    std::vector<Ref> left, right;
-    AABB lbox = box, rbox = box;
-    lbox.hi[axis] = split;
-    rbox.lo[axis] = split;
-    partition(refs, axis, split, insertion_margin(box), lbox, rbox, left, right);
-    if (stop(box, n, lbox, left.size(), rbox, right.size(), path)) {
-      make_leaf(refs, out);
-      return;
-    }
-    std::vector<Ref>().swap(refs);
-    const size_t all = left.size() + right.size();
+    if (n <= config_.leaf_size || depth >= depth_limit_ || !median_plane(node, axis, split))
+      return make_leaf(node.ids, out);
+    // Conservative: a primitive touching the plane or within the margin of it goes to both children.
+    const float margin = insertion_margin(node.box);
+    auto side = [&](const AABB& cb) {
+      const bool below = cb.lo[axis] <= split + margin, above = cb.hi[axis] >= split - margin;
+      return uint8_t(below ? (above ? 3 : 1) : 2);
+    };
+    KdBoxNode left, right;
+    partition_box_node(prims_, node, axis, split, margin, side, left, right);
+    if (stop(node.box, n, left.box, left.ids.size(), right.box, right.ids.size(), path))
+      return make_leaf(node.ids, out);
+    node = KdBoxNode{};
+    const size_t all = left.ids.size() + right.ids.size();
     if (ledger_) ledger_->add_children(all);
-    const Path lp{depth + 1, path.bad, path.budget.share(left.size(), all)};
-    const Path rp{depth + 1, path.bad, path.budget.share(right.size(), all)};
+    const Path lp{depth + 1, path.bad, path.budget.share(left.ids.size(), all)};
+    const Path rp{depth + 1, path.bad, path.budget.share(right.ids.size(), all)};
     const size_t self = out.nodes.size();
     out.nodes.push_back(KdNode::leaf(0, 0));
-    if (n >= kParallelMin) {
-      KdBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lbox, lp, lb); },
-                           [&] { build_node(std::move(right), rbox, rp, rb); });
-      out.append(lb);
-      out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
-      out.append(rb);
-    } else {
-      build_node(std::move(left), lbox, lp, out);
-      out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rbox, rp, out);
-    }
+    build_kd_children(
+        out, self, axis, split, n >= kParallelMin, [&](KdBuffer& b) { build_node(std::move(left), lp, b); },
+        [&](KdBuffer& b) { build_node(std::move(right), rp, b); });
   }
 
   /// Median of the clipped centres along axis; false when it does not lie strictly inside the box.
-  static bool median_plane(const std::vector<Ref>& refs, const AABB& box, int axis, float& split) {
-    std::vector<float> c(refs.size());
-    for (size_t i = 0; i < refs.size(); ++i) c[i] = 0.5f * (refs[i].cb.lo[axis] + refs[i].cb.hi[axis]);
+  static bool median_plane(const KdBoxNode& node, int axis, float& split) {
+    thread_local std::vector<float> c;
+    c.resize(node.bounds.size());
+    for (size_t i = 0; i < c.size(); ++i) c[i] = 0.5f * (node.bounds[i].lo[axis] + node.bounds[i].hi[axis]);
     auto mid = c.begin() + c.size() / 2;
     std::nth_element(c.begin(), mid, c.end());
     split = *mid;
-    return split > box.lo[axis] && split < box.hi[axis];
+    return split > node.box.lo[axis] && split < node.box.hi[axis];
   }
 
-  void partition(const std::vector<Ref>& refs, int axis, float split, float margin, const AABB& lbox,
-                 const AABB& rbox, std::vector<Ref>& left, std::vector<Ref>& right) const {
-    for (const Ref& r : refs) {
-      const bool to_left = r.cb.lo[axis] <= split + margin;
-      const bool to_right = r.cb.hi[axis] >= split - margin;
-      if (to_left && to_right) {
-        left.push_back({r.id, clip_into_child(prims_, r.id, lbox, margin)});
-        right.push_back({r.id, clip_into_child(prims_, r.id, rbox, margin)});
-      } else if (to_left) {
-        left.push_back(r);
-      } else {
-        right.push_back(r);
-      }
-    }
-  }
-
-  void make_leaf(const std::vector<Ref>& refs, KdBuffer& out) const {
-    if (ledger_) ledger_->add_leaf(refs.size());
-    std::vector<uint32_t> ids(refs.size());
-    for (size_t i = 0; i < refs.size(); ++i) ids[i] = refs[i].id;
-    std::sort(ids.begin(), ids.end());
+  /// Appends a leaf of ids (in the node's order, which is ascending: the root's, kept by every partition).
+  void make_leaf(const std::vector<uint32_t>& ids, KdBuffer& out) const {
+    if (ledger_) ledger_->add_leaf(ids.size());
     out.nodes.push_back(out.make_leaf(ids));
   }
 
-  /// Nodes at least this large build their children in parallel.
-  static constexpr size_t kParallelMin = 16384;
+  /// Nodes at least this large build their children in parallel (1024: the two threads stay busy on
+  /// unbalanced trees; the same tree for any thread count, subtrees appended in a fixed order).
+  static constexpr size_t kParallelMin = 1024;
   const P& prims_;
   KdMedianConfig config_;
   int depth_limit_;

@@ -2,6 +2,8 @@
 // section 4.4), shared by both k-d builders and the traversal.
 #pragma once
 
+#include <tbb/parallel_invoke.h>
+
 #include <bit>
 #include <cstdint>
 
@@ -65,5 +67,24 @@ static_assert(sizeof(KdNode) == 8);
 
 /// The nodes and leaf references a k-d builder writes (depth-first: the below child next to its parent).
 using KdBuffer = TreeBuffer<KdNode>;
+
+/// Builds the two subtrees of the interior node at out.nodes[self] (a placeholder): below(buffer) writes
+/// the below subtree, above(buffer) the above one. In parallel, the below subtree is still written into
+/// out directly and only the above one into a buffer of its own, appended after it: the serial layout, so
+/// the same tree for any thread count, and each subtree copied once per level of parallel ancestors at most.
+template <class Below, class Above>
+void build_kd_children(KdBuffer& out, size_t self, int axis, float split, bool parallel, Below&& below,
+                       Above&& above) {
+  if (!parallel) {
+    below(out);
+    out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
+    above(out);
+    return;
+  }
+  KdBuffer above_buffer;
+  tbb::parallel_invoke([&] { below(out); }, [&] { above(above_buffer); });
+  out.nodes[self] = KdNode::interior(axis, split, uint32_t(out.nodes.size()));
+  out.append(above_buffer);
+}
 
 }  // namespace ab

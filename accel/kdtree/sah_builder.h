@@ -1,9 +1,13 @@
 // The O(N log N) SAH k-d tree build of Wald and Havran 2006, "On building fast kd-trees for ray tracing,
 // and on doing that in O(N log N)": every node keeps, per axis, the list of its primitives' start, end and
-// planar events sorted once at the root; the best plane of all three axes is found by one linear sweep,
-// and the lists are split into the children's lists in linear time (primitives on one side keep their
-// events in order; straddling ones are clipped to each child box, "perfect splits", and their few new
-// events sorted and merged). Cost model (SahCosts, sah.h): C = lambda (Ct + Ci (P_L N_L + P_R N_R)) with
+// planar events, sorted; the best plane of all three axes is found by one linear sweep (sah_sweep.h), and
+// the lists are split into the children's lists in linear time (primitives on one side keep their events
+// in order; straddling ones are clipped to each child box, "perfect splits", and their few new events
+// sorted and merged). Nodes above exact_max primitives (the top levels of a large mesh) choose their plane
+// from bins instead and keep clipped boxes rather than events (sah_bins.h: Shevtsov, Soupikov and Kapustin
+// 2007; Hunt, Mark and Stoll 2006), partitioned by the same classification and clipping in parallel; a
+// node at exact_max or fewer gets its sorted events (Wald and Havran's lists, made per subtree) and the
+// exact sweep from there. Cost model (SahCosts, sah.h): C = lambda (Ct + Ci (P_L N_L + P_R N_R)) with
 // lambda = 1 - bonus when one side is empty; planar primitives are counted on the cheaper side; a node
 // becomes a leaf when no plane beats Ci N, unless it holds more than max_leaf primitives: then it splits at
 // its cheapest plane anyway when both children hold fewer than it. The SAH assumes rays that never stop
@@ -22,6 +26,7 @@
 // drops a sliver.
 #pragma once
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
@@ -29,6 +34,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "accel/common/conservative_insertion.h"
@@ -36,122 +42,10 @@
 #include "accel/common/sah.h"
 #include "accel/kdtree/config.h"
 #include "accel/kdtree/node.h"
+#include "accel/kdtree/sah_bins.h"
+#include "accel/kdtree/sah_sweep.h"
 
 namespace ab {
-
-/// A sweep event: position along one axis and (primitive's index in its node << 2 | type).
-struct KdEvent {
-  float pos;     ///< position along the axis
-  uint32_t key;  ///< local index << 2 | type
-
-  /// Event types, in the order the sweep needs at one position: ends, planars, starts.
-  enum Type : uint32_t { kEnd = 0, kPlanar = 1, kStart = 2 };
-  /// Index of the primitive in its node.
-  uint32_t local() const { return key >> 2; }
-  /// The event's type.
-  uint32_t type() const { return key & 3u; }
-  /// Total order: position, then type, then primitive (so any sort gives the same list).
-  bool operator<(const KdEvent& o) const {
-    if (pos != o.pos) return pos < o.pos;
-    const uint32_t ta = type(), tb = o.type();
-    return ta != tb ? ta < tb : key < o.key;
-  }
-};
-
-/// A node under construction: box, primitive ids and the sorted events of each axis.
-struct KdEventNode {
-  AABB box;                                    ///< the node's box
-  std::vector<uint32_t> ids;                   ///< its primitives
-  std::array<std::vector<KdEvent>, 3> events;  ///< per axis, sorted
-};
-
-/// Appends the events of a primitive with clipped bounds cb as local index `local`.
-inline void add_kd_events(const AABB& cb, uint32_t local, std::array<std::vector<KdEvent>, 3>& ev) {
-  for (int a = 0; a < 3; ++a) {
-    if (cb.lo[a] == cb.hi[a]) {
-      ev[a].push_back({cb.lo[a], (local << 2) | KdEvent::kPlanar});
-    } else {
-      ev[a].push_back({cb.lo[a], (local << 2) | KdEvent::kStart});
-      ev[a].push_back({cb.hi[a], (local << 2) | KdEvent::kEnd});
-    }
-  }
-}
-
-/// Result of the sweep.
-struct KdSahPlane {
-  int axis = -1;                     ///< -1: no plane inside the box
-  float pos = 0.0f;                  ///< plane position
-  float cost = kInf;                 ///< its SAH cost
-  bool planar_left = true;           ///< planar primitives at pos are counted on the left
-  uint32_t n_left = 0, n_right = 0;  ///< primitives on each side
-};
-
-/// Area terms of the children of a node box along one axis, so that each plane costs a few flops.
-struct KdAxisAreas {
-  float lo, hi, cap, side, inv_area;  ///< child area = (cap + side * length) * inv_area
-
-  /// Terms of box along axis a.
-  KdAxisAreas(const AABB& box, int a) : lo(box.lo[a]), hi(box.hi[a]) {
-    const vec3 e = box.extent();
-    const float e1 = e[(a + 1) % 3], e2 = e[(a + 2) % 3];
-    cap = 2.0f * e1 * e2;
-    side = 2.0f * (e1 + e2);
-    inv_area = 1.0f / box.area();
-  }
-};
-
-/// The cheapest plane of a node, and the cheapest one that leaves fewer than all n primitives on each side
-/// (the plane of a max_leaf split, which must make progress).
-struct KdSahChoice {
-  KdSahPlane best;      ///< cheapest plane
-  KdSahPlane progress;  ///< cheapest plane with both sides smaller than the node
-};
-
-/// Keeps plane (a, pos, cost c, planar side, counts) in best when cheaper.
-inline void keep_cheaper(KdSahPlane& best, int a, float pos, float c, bool planar_left, uint32_t nl,
-                         uint32_t nr) {
-  if (c < best.cost) best = {a, pos, c, planar_left, nl, nr};
-}
-
-/// Evaluates plane `pos` on axis a with the paper's counts, both placements of planar primitives. The
-/// areas are relative to the node's (the probabilities P_L, P_R), so the cost model is called with a
-/// parent area of 1.
-inline void evaluate_kd_plane(const SahCosts& costs, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
-                              uint32_t np, uint32_t nr, uint32_t n, KdSahChoice& choice) {
-  const float pl = (ar.cap + ar.side * (pos - ar.lo)) * ar.inv_area;
-  const float pr = (ar.cap + ar.side * (ar.hi - pos)) * ar.inv_area;
-  const float cl = costs.split(1.0f, pl, nl + np, pr, nr);
-  const float cr = np ? costs.split(1.0f, pl, nl, pr, nr + np) : cl;
-  keep_cheaper(choice.best, a, pos, std::min(cl, cr), cl <= cr, cl <= cr ? nl + np : nl,
-               cl <= cr ? nr : nr + np);
-  if (nl + np < n && nr < n) keep_cheaper(choice.progress, a, pos, cl, true, nl + np, nr);
-  if (np && nl < n && nr + np < n) keep_cheaper(choice.progress, a, pos, cr, false, nl, nr + np);
-}
-
-/// Finds the cheapest plane strictly inside the node box by one sweep per axis (Wald and Havran 2006,
-/// algorithm 4).
-inline KdSahChoice find_kd_sah_plane(const SahCosts& costs, const KdEventNode& node) {
-  KdSahChoice best;
-  if (!(node.box.area() > 0.0f)) return best;
-  const uint32_t n = uint32_t(node.ids.size());
-  for (int a = 0; a < 3; ++a) {
-    const std::vector<KdEvent>& ev = node.events[a];
-    const KdAxisAreas ar(node.box, a);
-    uint32_t nl = 0, nr = n;
-    for (size_t i = 0; i < ev.size();) {
-      const float p = ev[i].pos;
-      uint32_t ends = 0, planars = 0, starts = 0;
-      for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kEnd; ++i) ++ends;
-      for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kPlanar; ++i) ++planars;
-      for (; i < ev.size() && ev[i].pos == p && ev[i].type() == KdEvent::kStart; ++i) ++starts;
-      nr -= planars + ends;
-      if (p > node.box.lo[a] && p < node.box.hi[a])
-        evaluate_kd_plane(costs, ar, a, p, nl, planars, nr, n, best);
-      nl += starts + planars;
-    }
-  }
-  return best;
-}
 
 /// Builds SAH k-d trees over a primitive set P.
 template <class P>
@@ -166,7 +60,7 @@ class KdSahBuilder {
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = KdBuffer{};
-      build_node(make_root(ids, box), {0, budget}, out);
+      build_node(make_box_root(prims_, ids, box), {0, budget}, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;
@@ -175,36 +69,17 @@ class KdSahBuilder {
   bool budget_exhausted() const { return budget_exhausted_; }
 
  private:
-  KdEventNode make_root(const std::vector<uint32_t>& ids, const AABB& box) const {
-    KdEventNode root;
-    root.box = box;
-    root.ids = ids;
-    for (auto& ev : root.events) ev.resize(2 * ids.size());
-    std::vector<uint8_t> used(ids.size() * 3);
-    tbb::parallel_for(size_t(0), ids.size(), [&](size_t i) {
-      const AABB cb = prims_.clipped_bounds(ids[i], box);
-      for (int a = 0; a < 3; ++a) {
-        const uint32_t key = uint32_t(i) << 2;
-        KdEvent* slot = &root.events[a][2 * i];
-        if (cb.lo[a] == cb.hi[a]) {
-          slot[0] = {cb.lo[a], key | KdEvent::kPlanar};
-          used[3 * i + a] = 1;
-        } else {
-          slot[0] = {cb.lo[a], key | KdEvent::kStart};
-          slot[1] = {cb.hi[a], key | KdEvent::kEnd};
-          used[3 * i + a] = 2;
-        }
-      }
-    });
-    for (int a = 0; a < 3; ++a) {
-      std::vector<KdEvent>& ev = root.events[a];
-      size_t k = 0;
-      for (size_t i = 0; i < ids.size(); ++i)
-        for (uint8_t j = 0; j < used[3 * i + a]; ++j) ev[k++] = ev[2 * i + j];
-      ev.resize(k);
-    }
-    tbb::parallel_for(0, 3, [&](int a) { tbb::parallel_sort(root.events[a].begin(), root.events[a].end()); });
-    return root;
+  /// A node the exact sweep takes over: its events, sorted per axis (the lists Wald and Havran sort once
+  /// at the root, made here per subtree). Sorted by KdEvent's total order: the same lists in any build.
+  static KdEventNode to_events(KdBoxNode&& node) {
+    KdEventNode e;
+    e.box = node.box;
+    e.ids = std::move(node.ids);
+    for (auto& ev : e.events) ev.reserve(2 * e.ids.size());
+    for (size_t i = 0; i < e.ids.size(); ++i) add_kd_events(node.bounds[i], uint32_t(i), e.events);
+    std::vector<AABB>().swap(node.bounds);
+    tbb::parallel_for(0, 3, [&](int a) { tbb::parallel_sort(e.events[a].begin(), e.events[a].end()); });
+    return e;
   }
 
   /// Where a node sits: its depth and its reference budget.
@@ -219,19 +94,35 @@ class KdSahBuilder {
     out.nodes.push_back(out.make_leaf(ids));
   }
 
-  void build_node(KdEventNode&& node, Path path, KdBuffer& out) const {
+  KdSahChoice find_plane(const KdEventNode& node) const { return find_kd_sah_plane(costs_, node); }
+  KdSahChoice find_plane(const KdBoxNode& node) const { return find_binned_kd_plane(costs_, node); }
+
+  /// The plane a node of n primitives splits at, or null for a leaf: the cheapest plane when it beats the
+  /// leaf, else (more than max_leaf primitives) the cheapest one with progress.
+  const KdSahPlane* chosen_plane(const KdSahChoice& choice, size_t n, bool& forced) const {
+    forced = choice.best.axis >= 0 && choice.best.cost >= costs_.leaf(n);  // max_leaf's split
+    if (choice.best.axis < 0 || (forced && (config_.max_leaf == 0 || n <= config_.max_leaf))) return nullptr;
+    const KdSahPlane& plane = forced ? choice.progress : choice.best;
+    return plane.axis < 0 ? nullptr : &plane;
+  }
+
+  /// Builds a node (KdBoxNode: binned planes, handed to the exact sweep at exact_max primitives or fewer;
+  /// KdEventNode: the exact sweep).
+  template <class Node>
+  void build_node(Node node, Path path, KdBuffer& out) const {
     if (ledger_ && ledger_->over()) return;  // an abandoned attempt
     const size_t n = node.ids.size();
+    if constexpr (std::is_same_v<Node, KdBoxNode>)
+      if (n <= config_.exact_max) return build_node(to_events(std::move(node)), path, out);
     KdSahChoice choice;
-    if (n > 0 && path.depth < depth_limit_) choice = find_kd_sah_plane(costs_, node);
-    const bool forced = choice.best.axis >= 0 && choice.best.cost >= costs_.leaf(n);  // max_leaf's split
-    if (choice.best.axis < 0 || (forced && (config_.max_leaf == 0 || n <= config_.max_leaf)))
-      return make_leaf(node.ids, out);
-    const KdSahPlane& plane = forced ? choice.progress : choice.best;
-    if (plane.axis < 0) return make_leaf(node.ids, out);
-    const float split = plane.pos;
-    KdEventNode left, right;
-    partition(std::move(node), plane.axis, split, plane.planar_left, left, right);
+    if (n > 0 && path.depth < depth_limit_) choice = find_plane(node);
+    bool forced = false;
+    const KdSahPlane* plane = chosen_plane(choice, n, forced);
+    if (!plane) return make_leaf(node.ids, out);
+    const int axis = plane->axis;
+    const float split = plane->pos;
+    Node left, right;
+    partition(std::move(node), axis, split, plane->planar_left, left, right);
     const size_t nl = left.ids.size(), nr = right.ids.size();
     if ((nl == n && nr == n) || (forced && std::max(nl, nr) == n) || !path.budget.allows(nl + nr)) {
       std::vector<uint32_t> ids = std::move(left.ids);  // all n when nl == n
@@ -243,18 +134,9 @@ class KdSahBuilder {
     const Path rp{path.depth + 1, path.budget.share(nr, nl + nr)};
     const size_t self = out.nodes.size();
     out.nodes.push_back(KdNode::leaf(0, 0));
-    if (n >= kParallelMin) {
-      KdBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lp, lb); },
-                           [&] { build_node(std::move(right), rp, rb); });
-      out.append(lb);
-      out.nodes[self] = KdNode::interior(plane.axis, split, uint32_t(out.nodes.size()));
-      out.append(rb);
-    } else {
-      build_node(std::move(left), lp, out);
-      out.nodes[self] = KdNode::interior(plane.axis, split, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rp, out);
-    }
+    build_kd_children(
+        out, self, axis, split, n >= kParallelMin, [&](KdBuffer& b) { build_node(std::move(left), lp, b); },
+        [&](KdBuffer& b) { build_node(std::move(right), rp, b); });
   }
 
   /// The node's primitives from its two children's lists (each in the node's order): sorted, once each.
@@ -265,18 +147,32 @@ class KdSahBuilder {
     return out;
   }
 
-  /// Splits node's primitives and events at `split` on axis a into left and right (linear time).
+  /// Splits a large node at `split` on axis a by kd_side on the clipped boxes, straddlers clipped into
+  /// each child (the exact partition's rules, so the subtree below is the one the exact build of this
+  /// node would make; partition_box_node).
+  void partition(KdBoxNode&& node, int a, float split, bool planar_left, KdBoxNode& left,
+                 KdBoxNode& right) const {
+    partition_box_node(
+        prims_, node, a, split, insertion_margin(node.box),
+        [&](const AABB& cb) { return kd_side(cb.lo[a], cb.hi[a], split, planar_left); }, left, right);
+    std::vector<uint32_t>().swap(node.ids);
+    std::vector<AABB>().swap(node.bounds);
+  }
+
+  /// Splits node's primitives and events at `split` on axis a into left and right (linear time). The
+  /// per-primitive scratch is kept per thread (no allocation per node).
   void partition(KdEventNode&& node, int a, float split, bool planar_left, KdEventNode& left,
                  KdEventNode& right) const {
     const size_t n = node.ids.size();
     const float margin = insertion_margin(node.box);
-    left.box = node.box;
-    right.box = node.box;
-    left.box.hi[a] = split;
-    right.box.lo[a] = split;
+    child_boxes(node.box, a, split, left.box, right.box);
     // Side of each primitive (bit 0 left, bit 1 right), Wald and Havran's classification: ending at or
     // before the plane is left only, starting at or after it right only, planar in it on the chosen side.
-    std::vector<uint8_t> side(n, 3);
+    thread_local std::vector<uint8_t> side;
+    thread_local std::vector<uint32_t> to_left, to_right;
+    side.assign(n, 3);
+    to_left.resize(n);
+    to_right.resize(n);
     for (const KdEvent& e : node.events[a]) {
       const uint32_t t = e.local();
       if (e.type() == KdEvent::kEnd && e.pos <= split)
@@ -286,24 +182,26 @@ class KdSahBuilder {
       else if (e.type() == KdEvent::kPlanar)
         side[t] = e.pos < split ? 1 : e.pos > split ? 2 : planar_left ? 1 : 2;
     }
-    std::vector<uint32_t> to_left(n), to_right(n);
+    size_t nl = 0, nr = 0, both = 0;
     for (size_t t = 0; t < n; ++t) {
-      if (side[t] & 1) {
-        to_left[t] = uint32_t(left.ids.size());
-        left.ids.push_back(node.ids[t]);
-      }
-      if (side[t] & 2) {
-        to_right[t] = uint32_t(right.ids.size());
-        right.ids.push_back(node.ids[t]);
-      }
+      nl += side[t] & 1;
+      nr += side[t] >> 1;
+      both += side[t] == 3;
+    }
+    left.ids.resize(nl);
+    right.ids.resize(nr);
+    for (size_t t = 0, l = 0, r = 0; t < n; ++t) {
+      if (side[t] & 1) left.ids[to_left[t] = uint32_t(l++)] = node.ids[t];
+      if (side[t] & 2) right.ids[to_right[t] = uint32_t(r++)] = node.ids[t];
     }
     for (int k = 0; k < 3; ++k) {
       const size_t m = node.events[k].size();
-      left.events[k].reserve(m * left.ids.size() / n + 8);
-      right.events[k].reserve(m * right.ids.size() / n + 8);
+      left.events[k].reserve(m * (nl - both) / n + 2 * both + 8);
+      right.events[k].reserve(m * (nr - both) / n + 2 * both + 8);
       split_events(node.events[k], side, to_left, to_right, left.events[k], right.events[k]);
       std::vector<KdEvent>().swap(node.events[k]);
     }
+    if (both == 0) return;
     add_straddlers(node.ids, side, to_left, margin, left);
     add_straddlers(node.ids, side, to_right, margin, right);
   }
@@ -321,10 +219,19 @@ class KdSahBuilder {
     }
   }
 
+  /// Merges the sorted `extra` into the sorted `ev` in place, from the back (std::merge's result: the keys
+  /// are distinct, so KdEvent's order has no ties).
+  static void merge_into(std::vector<KdEvent>& ev, const std::vector<KdEvent>& extra) {
+    size_t i = ev.size(), j = extra.size(), k = i + j;
+    ev.resize(k);
+    while (j > 0) ev[--k] = (i > 0 && extra[j - 1] < ev[i - 1]) ? ev[--i] : extra[--j];
+  }
+
   /// Clips the primitives on both sides into child (perfect splits), sorts their events and merges them in.
   void add_straddlers(const std::vector<uint32_t>& ids, const std::vector<uint8_t>& side,
                       const std::vector<uint32_t>& to_child, float margin, KdEventNode& child) const {
-    std::array<std::vector<KdEvent>, 3> extra;
+    thread_local std::array<std::vector<KdEvent>, 3> extra;
+    for (auto& e : extra) e.clear();
     for (size_t t = 0; t < ids.size(); ++t) {
       if (side[t] != 3) continue;
       add_kd_events(clip_into_child(prims_, ids[t], child.box, margin), to_child[t], extra);
@@ -332,10 +239,7 @@ class KdSahBuilder {
     for (int k = 0; k < 3; ++k) {
       if (extra[k].empty()) continue;
       std::sort(extra[k].begin(), extra[k].end());
-      std::vector<KdEvent> merged(child.events[k].size() + extra[k].size());
-      std::merge(child.events[k].begin(), child.events[k].end(), extra[k].begin(), extra[k].end(),
-                 merged.begin());
-      child.events[k].swap(merged);
+      merge_into(child.events[k], extra[k]);
     }
   }
 
