@@ -1,5 +1,5 @@
-// Octree: child boxes, traversal against brute on geometry and rays lying in the mid-planes, depth and
-// leaf-size limits, statistics and thread-count independence.
+// Octree: child boxes, traversal against brute on geometry and rays lying in the mid-planes, the mailbox,
+// depth and leaf-size limits, statistics and thread-count independence.
 #include "accel/octree/octree.h"
 
 #include <gtest/gtest.h>
@@ -98,6 +98,20 @@ TEST(Octree, MatchesBruteOnAdversarialMeshesAndInstances) {
   auto inst = testing::make_instances(random_soup(200, 2), "octree", 7);
   EXPECT_EQ(
       testing::count_instance_differences("octree", inst, adversarial_rays(random_soup(50, 1), 2000, 6)), 0u);
+}
+
+TEST(Octree, MailboxTestsATriangleOncePerRay) {
+  // Triangles larger than the leaves: a ray meets each in several leaves and tests it once.
+  const Mesh mesh = random_soup(3000, 23, 0.05f);
+  const std::vector<Ray> rays = adversarial_rays(mesh, 1000, 24);
+  for (const char* copies : {"off", "on"}) {
+    auto accel = built(mesh, {{"leaf_copies", copies}});
+    std::vector<Hit> hits(rays.size());
+    RayCounters c;
+    accel->intersect_counted(rays, hits, c);
+    EXPECT_GT(c.mailbox_skips, 0u) << copies;
+    EXPECT_EQ(count_differences("octree", mesh, rays, {{"leaf_copies", copies}}), 0u) << copies;
+  }
 }
 
 TEST(Octree, RespectsDepthAndLeafSize) {

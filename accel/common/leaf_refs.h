@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "accel/common/id_lists.h"
+#include "accel/common/mailbox.h"
 #include "accel/core/primitives.h"
 #include "accel/core/triangle.h"
 
@@ -71,6 +72,30 @@ class LeafRefs {
       }
     }
     intersect_id_list<kCount>(prims, ids_.data() + first, count, ray, best, inst, c);
+  }
+  /// Closest hit over the references [first, first + count) that the mailbox has not seen for this ray:
+  /// the same kernel, each primitive tested once however many of the ray's leaves reference it (a
+  /// primitive already tested cannot win later, as the best hit only gets closer).
+  template <bool kCount>
+  [[gnu::always_inline]] void intersect_unseen(const P& prims, uint32_t first, uint32_t count, const Ray& ray,
+                                               Hit& best, uint32_t inst, RayCounters& c,
+                                               Mailbox& mailbox) const {
+    for (uint32_t k = first, e = first + count; k < e; ++k) {
+      if (mailbox.seen(ids_[k])) {
+        if constexpr (kCount) ++c.mailbox_skips;
+        continue;
+      }
+      if constexpr (kCanCopy) {
+        if (!tris_.empty()) {
+          if constexpr (kCount) ++c.prims;
+          TriangleHit th;
+          if (intersect_triangle(ray, tris_[k], th) && is_better_hit(th.t, inst, ids_[k], best))
+            best = {th.t, ids_[k], inst, th.u, th.v};
+          continue;
+        }
+      }
+      intersect_id_list<kCount>(prims, &ids_[k], 1, ray, best, inst, c);
+    }
   }
   /// True when any reference in [first, first + count) blocks the ray.
   template <bool kCount>

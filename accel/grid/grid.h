@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "accel/common/mailbox.h"
 #include "accel/core/accelerator.h"
 #include "accel/core/box_test.h"
 #include "accel/core/params.h"
@@ -101,25 +102,6 @@ float insertion_margin(const GridLayout& layout);
 /// only grows, so that depends on the grid alone, not on the threads).
 GridCells build_grid_cells(const GridLayout& layout, size_t n, const CellInserter& insert,
                            uint64_t max_refs = UINT64_MAX);
-
-/// A small direct-mapped per-ray mailbox (Amanatides and Woo 1987, section 4): remembers recently tested
-/// ids so a primitive spanning several cells is tested once. It lives on the tracing thread's stack, so it
-/// is thread-safe; a collision only costs a repeated test, never a skipped one.
-class Mailbox {
- public:
-  Mailbox() { slots_.fill(kInvalidId); }
-  /// True when id was already tested for this ray; otherwise records it and returns false.
-  bool seen(uint32_t id) {
-    uint32_t& slot = slots_[id & (kSize - 1)];
-    if (slot == id) return true;
-    slot = id;
-    return false;
-  }
-
- private:
-  static constexpr uint32_t kSize = 64;
-  std::array<uint32_t, kSize> slots_;
-};
 
 /// The state of a 3D-DDA walk: the current cell and, per axis, the step and the ray parameter of the
 /// next plane crossing (computed directly from the plane position each time, never accumulated).

@@ -17,6 +17,7 @@
 #include "accel/common/depth_limit.h"
 #include "accel/common/finite_primitives.h"
 #include "accel/common/leaf_refs.h"
+#include "accel/common/mailbox.h"
 #include "accel/common/spatial_tree_queries.h"
 #include "accel/common/split_plane.h"
 #include "accel/common/traversal_stack.h"
@@ -69,6 +70,23 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
 
   /// Bounds of the primitives.
   AABB bounds() const override { return prims_->bounds(); }
+
+  /// Closest hit, front to back, with a per-ray mailbox (Amanatides and Woo 1987, section 4): a triangle
+  /// copied into several cells the ray crosses (on average 4-6 per triangle on the 1M-10M soup and
+  /// sphereflake) is tested once. Hides SpatialTreeQueries' closest hit; the any-hit query is its.
+  template <bool kCount>
+  [[gnu::flatten]] void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
+    if (!unbounded_.empty())
+      intersect_id_list<kCount>(*prims_, unbounded_.data(), uint32_t(unbounded_.size()), ray, best, inst, c);
+    Mailbox mailbox;
+    traverse<kCount>(
+        ray, c,
+        [&](uint32_t first, uint32_t count) {
+          leaves_.template intersect_unseen<kCount>(*prims_, first, count, ray, best, inst, c, mailbox);
+          return false;
+        },
+        [&] { return best.t; });
+  }
 
  protected:
   void do_build() override {
