@@ -45,28 +45,6 @@ Ray awkward_ray(std::mt19937& rng) {
   return r;
 }
 
-/// The box test specialised to the octant of the test's ray (what the uncounted walk calls).
-unsigned entries_in_octant(const Bvh8RayTest& test, int octant, const Bvh8Node& n, float limit, float* t) {
-  switch (octant) {
-    case 0:
-      return test.entries<0>(n, limit, t);
-    case 1:
-      return test.entries<1>(n, limit, t);
-    case 2:
-      return test.entries<2>(n, limit, t);
-    case 3:
-      return test.entries<3>(n, limit, t);
-    case 4:
-      return test.entries<4>(n, limit, t);
-    case 5:
-      return test.entries<5>(n, limit, t);
-    case 6:
-      return test.entries<6>(n, limit, t);
-    default:
-      return test.entries<7>(n, limit, t);
-  }
-}
-
 TEST(Bvh8, SimdBoxTestEqualsTheScalarOneLaneByLane) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 20000; ++trial) {
@@ -85,14 +63,12 @@ TEST(Bvh8, SimdBoxTestEqualsTheScalarOneLaneByLane) {
     const Bvh8RayTest test(ray);
     const float limit =
         rng() % 2 ? ray.tmax : std::min(ray.tmax, uniform(rng, 0, 2));  // as the walk passes it
-    alignas(32) float simd[8], scalar[8], octant[8];
+    alignas(32) float simd[8], scalar[8];
     const unsigned m1 = test.entries(node, limit, simd), m2 = test.entries_scalar(node, limit, scalar);
     ASSERT_EQ(m1, m2) << "trial " << trial;
-    ASSERT_EQ(entries_in_octant(test, Bvh8RayTest::octant_of(ray), node, limit, octant), m1) << trial;
     for (int k = 0; k < 8; ++k) {
       if (m1 >> k & 1) {
         ASSERT_EQ(bits(simd[k]) & 0x7fffffffu, bits(scalar[k]) & 0x7fffffffu) << trial;
-        ASSERT_EQ(bits(octant[k]), bits(simd[k])) << trial;
       }
       // A lane entered by the wide test is entered by the binary test's arithmetic too.
       if (!node.used(k)) {
@@ -141,41 +117,6 @@ TEST(Bvh8, EnteredChildrenAreRankedFarthestFirst) {
       }
     }
     EXPECT_EQ(seen, mask) << trial;  // every entered lane exactly once
-  }
-}
-
-TEST(Bvh8, StackedChildrenComeBackNearestFirst) {
-  // stack_entered_children returns one entered child and stacks the others: sorted, the returned one is the
-  // nearest and the stack pops the rest nearer first; unsorted, every entered lane once. Two children take
-  // their own path (one compare), more the ranking.
-  std::mt19937 rng(11);
-  Bvh8Node node{};
-  for (int k = 0; k < 8; ++k) node.child[k] = uint32_t(100 + k), node.count[k] = 0;
-  for (int trial = 0; trial < 20000; ++trial) {
-    unsigned mask = rng() & 0xffu;
-    if (trial % 2 == 0) mask = (1u << (rng() % 8)) | (1u << (rng() % 8));  // two lanes often
-    if (std::popcount(mask) < 2) mask |= 3u << (rng() % 7);
-    alignas(32) float t[8];
-    for (float& x : t) x = rng() % 5 == 0 ? 1.0f : uniform(rng, 0, 4);  // ties too
-    for (const bool sorted : {true, false}) {
-      Bvh8Stack stack;
-      const Bvh8StackEntry next =
-          sorted ? stack_entered_children<true>(&node, node, mask, t, stack, nullptr, 0)
-                 : stack_entered_children<false>(&node, node, mask, t, stack, nullptr, 0);
-      unsigned seen = 1u << (next.child - 100);
-      float last = next.t;
-      for (Bvh8StackEntry e; stack.pop(kInf, e);) {
-        const unsigned lane = e.child - 100;
-        ASSERT_FALSE(seen >> lane & 1) << trial;
-        seen |= 1u << lane;
-        EXPECT_EQ(bits(e.t), bits(t[lane]));
-        if (sorted) {  // within the ranking key's three dropped low bits distances count as ties
-          EXPECT_LE(bits(last) & ~7u, bits(e.t) & ~7u) << trial;
-        }
-        last = e.t;
-      }
-      EXPECT_EQ(seen, mask) << trial;
-    }
   }
 }
 

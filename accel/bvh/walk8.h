@@ -5,7 +5,6 @@
 #pragma once
 
 #include <bit>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -34,42 +33,27 @@ namespace ab {
 /// an ulp of a margin 256 ulps wide. That takes the widening's compares, blends and multiplies out of every
 /// node (20 operations instead of 27).
 struct Bvh8RayTest {
-  /// Prepares the per-ray data of the box tests (broadcast to eight lanes with AVX2). Inlined into the walk,
-  /// so the broadcasts stay in registers: the folded path's reciprocals are inv_dir * (1 -+ kBoxEps), the
-  /// general path's (tmin < 0) inv_dir itself (times 1, the same bits), both stored negated (slab()).
-  [[gnu::always_inline]] explicit Bvh8RayTest(const Ray& ray)
-      : rd(ray), tmin(ray.tmin), folded(ray.tmin >= 0.0f) {
+  /// Prepares the per-ray data of the box tests (broadcast to eight lanes with AVX2).
+  explicit Bvh8RayTest(const Ray& ray) : rd(ray), tmin(ray.tmin), folded(ray.tmin >= 0.0f) {
     for (int a = 0; a < 3; ++a) {
       near_row[a] = a + 3 * rd.neg[a];
       far_row[a] = a + 3 * (1 - rd.neg[a]);
     }
 #if defined(__AVX2__)
-    const float shrink = folded ? 1.0f - kBoxEps : 1.0f, grow = folded ? 1.0f + kBoxEps : 1.0f;
     for (int a = 0; a < 3; ++a) {
       org[a] = _mm256_set1_ps(rd.org[a]);
-      neg_inv_near[a] = _mm256_set1_ps(-(rd.inv_dir[a] * shrink));
-      neg_inv_far[a] = _mm256_set1_ps(-(rd.inv_dir[a] * grow));
+      inv[a] = _mm256_set1_ps(rd.inv_dir[a]);
+      inv_near[a] = _mm256_set1_ps(rd.inv_dir[a] * (1.0f - kBoxEps));
+      inv_far[a] = _mm256_set1_ps(rd.inv_dir[a] * (1.0f + kBoxEps));
     }
     tmin8 = _mm256_set1_ps(tmin);
 #endif
   }
 
-  /// The octant of ray's direction: bit a set where dir[a] has its sign bit set (as RayBoxData::neg: its
-  /// near plane is then the hi row).
-  static int octant_of(const Ray& ray) {
-    return int(std::signbit(ray.dir.x)) | int(std::signbit(ray.dir.y)) << 1 |
-           int(std::signbit(ray.dir.z)) << 2;
-  }
-
-  /// Entry distances into t[0..7]; returns the mask of lanes entered. kOctant >= 0 (the ray's octant_of)
-  /// makes the rows of the near and far planes constants, so each row is one load folded into the
-  /// subtraction (the walk instantiates one loop per octant, as tinybvh's BVH8_CPU and Fuetterling et al.
-  /// 2017, "Accelerated single ray tracing for wide vector units", specialise by octant); -1 reads them
-  /// from near_row and far_row.
-  template <int kOctant = -1>
+  /// Entry distances into t[0..7]; returns the mask of lanes entered.
   [[gnu::always_inline]] unsigned entries(const Bvh8Node& n, float limit, float* t) const {
 #if defined(__AVX2__)
-    return entries_of_rows<kOctant>([&](int row) { return _mm256_load_ps(n.bounds[row]); }, limit, t);
+    return entries_of_rows([&](int row) { return _mm256_load_ps(n.bounds[row]); }, limit, t);
 #else
     return entries_scalar(n, limit, t);
 #endif
@@ -78,61 +62,47 @@ struct Bvh8RayTest {
 #if defined(__AVX2__)
   /// The same for boxes given as rows (`n(row)`: eight lanes of bounds row lo x, y, z, hi x, y, z), such as
   /// boxes a motion node interpolates at the ray's time (motion_node8.h).
-  template <int kOctant = -1, class Rows>
+  template <class Rows>
   [[gnu::always_inline]] unsigned entries_of_rows(const Rows& n, float limit, float* t) const {
-    const __m256 t0 = folded ? folded_near<kOctant>(n) : general_near<kOctant>(n);
-    const __m256 t1 = folded ? folded_far<kOctant>(n, limit) : general_far<kOctant>(n, limit);
+    const __m256 t0 = folded ? folded_near(n) : general_near(n);
+    const __m256 t1 = folded ? folded_far(n, limit) : general_far(n, limit);
     _mm256_store_ps(t, t0);
     return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
   }
-  /// The bounds row of axis a's near plane (far: the other one), a constant for kOctant >= 0.
-  template <int kOctant>
-  [[gnu::always_inline]] int near_of(int a) const {
-    if constexpr (kOctant < 0) return near_row[a];
-    return a + 3 * ((kOctant >> a) & 1);
-  }
-  /// The bounds row of axis a's far plane.
-  template <int kOctant>
-  [[gnu::always_inline]] int far_of(int a) const {
-    if constexpr (kOctant < 0) return far_row[a];
-    return a + 3 * (1 - ((kOctant >> a) & 1));
-  }
-  /// (plane - org) * reciprocal on bounds row `row` (eight lanes), computed as (org - plane) * -reciprocal:
-  /// the same bits but for the sign of a zero (IEEE subtraction and multiplication round symmetrically), with
-  /// the row's load folded into the subtraction.
+  /// (plane - org) * reciprocal on axis a of bounds row `row` (eight lanes).
   template <class Rows>
-  [[gnu::always_inline]] static __m256 slab(const Rows& n, int row, __m256 o, __m256 neg_r) {
-    return _mm256_mul_ps(_mm256_sub_ps(o, n(row)), neg_r);
+  [[gnu::always_inline]] static __m256 slab(const Rows& n, int row, __m256 o, __m256 r) {
+    return _mm256_mul_ps(_mm256_sub_ps(n(row), o), r);
   }
   /// Folded path: max(near_x, near_y, near_z, tmin), each max keeping the bound on NaN.
-  template <int kOctant, class Rows>
+  template <class Rows>
   [[gnu::always_inline]] __m256 folded_near(const Rows& n) const {
-    __m256 t0 = _mm256_max_ps(slab(n, near_of<kOctant>(2), org[2], neg_inv_near[2]), tmin8);
-    t0 = _mm256_max_ps(slab(n, near_of<kOctant>(1), org[1], neg_inv_near[1]), t0);
-    return _mm256_max_ps(slab(n, near_of<kOctant>(0), org[0], neg_inv_near[0]), t0);
+    __m256 t0 = _mm256_max_ps(slab(n, near_row[2], org[2], inv_near[2]), tmin8);
+    t0 = _mm256_max_ps(slab(n, near_row[1], org[1], inv_near[1]), t0);
+    return _mm256_max_ps(slab(n, near_row[0], org[0], inv_near[0]), t0);
   }
   /// Folded path: min(far_x, far_y, far_z, limit), each min keeping the bound on NaN.
-  template <int kOctant, class Rows>
+  template <class Rows>
   [[gnu::always_inline]] __m256 folded_far(const Rows& n, float limit) const {
-    __m256 t1 = _mm256_min_ps(slab(n, far_of<kOctant>(2), org[2], neg_inv_far[2]), _mm256_set1_ps(limit));
-    t1 = _mm256_min_ps(slab(n, far_of<kOctant>(1), org[1], neg_inv_far[1]), t1);
-    return _mm256_min_ps(slab(n, far_of<kOctant>(0), org[0], neg_inv_far[0]), t1);
+    __m256 t1 = _mm256_min_ps(slab(n, far_row[2], org[2], inv_far[2]), _mm256_set1_ps(limit));
+    t1 = _mm256_min_ps(slab(n, far_row[1], org[1], inv_far[1]), t1);
+    return _mm256_min_ps(slab(n, far_row[0], org[0], inv_far[0]), t1);
   }
-  /// General path (any tmin; the reciprocals are -inv_dir): the widened near distance clipped to tmin.
-  template <int kOctant, class Rows>
+  /// General path (any tmin): the widened near distance clipped to tmin.
+  template <class Rows>
   [[gnu::always_inline]] __m256 general_near(const Rows& n) const {
     __m256 tn = _mm256_set1_ps(-kInf);
-    for (int a = 0; a < 3; ++a) tn = _mm256_max_ps(slab(n, near_of<kOctant>(a), org[a], neg_inv_near[a]), tn);
+    for (int a = 0; a < 3; ++a) tn = _mm256_max_ps(slab(n, near_row[a], org[a], inv[a]), tn);
     const __m256 shrink = _mm256_set1_ps(1.0f - kBoxEps), grow = _mm256_set1_ps(1.0f + kBoxEps);
     tn =
         _mm256_mul_ps(tn, _mm256_blendv_ps(grow, shrink, _mm256_cmp_ps(tn, _mm256_setzero_ps(), _CMP_GT_OQ)));
     return _mm256_max_ps(tn, tmin8);
   }
   /// General path: the widened far distance clipped to limit.
-  template <int kOctant, class Rows>
+  template <class Rows>
   [[gnu::always_inline]] __m256 general_far(const Rows& n, float limit) const {
     __m256 tf = _mm256_set1_ps(kInf);
-    for (int a = 0; a < 3; ++a) tf = _mm256_min_ps(slab(n, far_of<kOctant>(a), org[a], neg_inv_far[a]), tf);
+    for (int a = 0; a < 3; ++a) tf = _mm256_min_ps(slab(n, far_row[a], org[a], inv[a]), tf);
     const __m256 shrink = _mm256_set1_ps(1.0f - kBoxEps), grow = _mm256_set1_ps(1.0f + kBoxEps);
     tf =
         _mm256_mul_ps(tf, _mm256_blendv_ps(shrink, grow, _mm256_cmp_ps(tf, _mm256_setzero_ps(), _CMP_GT_OQ)));
@@ -174,11 +144,11 @@ struct Bvh8RayTest {
 
   RayBoxData rd;                ///< origin, reciprocal direction, sign bits
   float tmin;                   ///< the ray's tmin (lower clip of every entry)
-  bool folded;                  ///< tmin >= 0: the widening is folded into the reciprocals
+  bool folded;                  ///< tmin >= 0: the widening is folded into inv_near and inv_far
   int near_row[3], far_row[3];  ///< bounds row of the near and far plane per axis
 #if defined(__AVX2__)
-  __m256 org[3], tmin8;                    ///< origin and tmin in every lane
-  __m256 neg_inv_near[3], neg_inv_far[3];  ///< -(inv_dir * (1 -+ kBoxEps)) (folded), or -inv_dir
+  __m256 org[3], inv[3], tmin8;    ///< origin, reciprocal direction and tmin in every lane
+  __m256 inv_near[3], inv_far[3];  ///< reciprocals times 1 - kBoxEps and 1 + kBoxEps (folded path)
 #endif
 };
 
@@ -252,33 +222,20 @@ template <class Node>
 
 /// Stacks the children of node n entered by the lanes of mask (at least two) and returns the one to visit
 /// next: sorted by entry distance, farthest stacked first (kSorted), or in lane order with the last lane
-/// next. Two children (the most frequent case after one) take one compare and one push, as in Embree 3's
-/// traverser (kernels/bvh/bvh_traverser1.h); more are ranked by rank_entered_children. Stacked nodes and
-/// leaf data (`leaf_data` + child * `leaf_stride` bytes, when not null) are prefetched.
+/// next. Stacked nodes and leaf data (`leaf_data` + child * `leaf_stride` bytes, when not null) are
+/// prefetched.
 template <bool kSorted, class Node>
 [[gnu::always_inline]] inline Bvh8StackEntry stack_entered_children(const Node* nodes, const Node& n,
                                                                     unsigned mask, const float* t,
                                                                     Bvh8Stack& stack, const char* leaf_data,
                                                                     size_t leaf_stride) {
-  const unsigned rest = mask & (mask - 1);
-  if ((rest & (rest - 1)) == 0) {
-    const int k0 = std::countr_zero(mask), k1 = std::countr_zero(rest);
-    int next = k1, later = k0;  // lane order: the last lane next
-    if constexpr (kSorted) {
-      if (t[k0] <= t[k1]) next = k0, later = k1;  // the nearer one next
-    }
-    const Bvh8StackEntry stacked{n.child[later], n.count[later], t[later]};
-    prefetch_entry(nodes, stacked, leaf_data, leaf_stride);
-    stack.push(stacked);
-    return {n.child[next], n.count[next], t[next]};
-  }
   Bvh8StackEntry items[8];
   int m = 0;
   if constexpr (kSorted) {
     m = rank_entered_children(n, mask, t, items);
   } else {
-    for (unsigned left = mask; left; left &= left - 1) {
-      const int k = std::countr_zero(left);
+    for (unsigned rest = mask; rest; rest &= rest - 1) {
+      const int k = std::countr_zero(rest);
       items[m++] = {n.child[k], n.count[k], t[k]};
     }
   }
@@ -289,21 +246,16 @@ template <bool kSorted, class Node>
   return items[m - 1];
 }
 
-/// Entry distances of node n's children by the test's octant-specialised entries<kOctant> where it has one
-/// (Bvh8RayTest), else by its entries (kOctant -1).
-template <int kOctant, class Test, class Node>
-[[gnu::always_inline]] inline unsigned node_entries(const Test& test, const Node& n, float limit, float* t) {
-  if constexpr (kOctant >= 0)
-    return test.template entries<kOctant>(n, limit, t);
-  else
-    return test.entries(n, limit, t);
-}
-
-/// walk_bvh8's loop for rays of one octant (kOctant >= 0: the test's rows are constants) or of any (-1).
-/// The test is made here, so its broadcasts live in registers and the rows it does not need are not made.
-template <bool kCount, bool kSorted, int kOctant, class Limit, class Leaf, class Node>
-[[gnu::always_inline]] inline bool walk_bvh8_loop(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
-                                                  const char* leaf_data, size_t leaf_stride, RayCounters& c) {
+/// Front-to-back walk of an 8-wide BVH (not empty; Bvh8Node, or a node of another bound with child[8],
+/// count[8] and the test it names, `using RayTest = ...;` with entries(node, limit, t)). `limit()` is the
+/// current upper bound of the box tests (min(tmax, best.t) for closest hit, tmax for any hit); `leaf(first,
+/// count)` tests a leaf and returns true to end the walk. Entered children are visited nearest first
+/// (kSorted) or in lane order; a stacked child is skipped only when its entry lies strictly beyond limit().
+/// Nodes and leaf data (`leaf_data` + first * `leaf_stride` bytes, when not null) are prefetched as soon as
+/// they are known to be entered. Returns true when a leaf ended the walk.
+template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
+[[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
+                                             const char* leaf_data, size_t leaf_stride, RayCounters& c) {
   const typename Node::RayTest test(ray);
   Bvh8Stack stack;
   Bvh8StackEntry cur{0, 0, ray.tmin};
@@ -312,7 +264,7 @@ template <bool kCount, bool kSorted, int kOctant, class Limit, class Leaf, class
     if (cur.count == 0) {
       const Node& n = nodes[cur.child];
       alignas(32) float t[8];
-      const unsigned mask = node_entries<kOctant>(test, n, limit(), t);
+      const unsigned mask = test.entries(n, limit(), t);
       if (mask != 0) {
         if ((mask & (mask - 1)) == 0) {  // one child entered: no stack traffic
           const int k = std::countr_zero(mask);
@@ -328,47 +280,6 @@ template <bool kCount, bool kSorted, int kOctant, class Limit, class Leaf, class
     }
     if (!stack.pop(limit(), cur)) return false;
   }
-}
-
-/// Front-to-back walk of an 8-wide BVH (not empty; Bvh8Node, or a node of another bound with child[8],
-/// count[8] and the test it names, `using RayTest = ...;` with entries(node, limit, t)). `limit()` is the
-/// current upper bound of the box tests (min(tmax, best.t) for closest hit, tmax for any hit); `leaf(first,
-/// count)` tests a leaf and returns true to end the walk. Entered children are visited nearest first
-/// (kSorted) or in lane order; a stacked child is skipped only when its entry lies strictly beyond limit().
-/// Nodes and leaf data (`leaf_data` + first * `leaf_stride` bytes, when not null) are prefetched as soon as
-/// they are known to be entered. Returns true when a leaf ended the walk. Uncounted walks with a test that
-/// has entries<kOctant> (Bvh8RayTest) take one loop per octant of the ray's direction (the counting pass
-/// the general one: the same nodes and leaves).
-template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
-[[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
-                                             const char* leaf_data, size_t leaf_stride, RayCounters& c) {
-  using Test = typename Node::RayTest;
-#define AB_WALK_BVH8_LOOP(octant) \
-  walk_bvh8_loop<kCount, kSorted, octant>(nodes, ray, limit, leaf, leaf_data, leaf_stride, c)
-  if constexpr (!kCount &&
-                requires(const Test& test, float* t) { test.template entries<0>(*nodes, 0.0f, t); }) {
-    switch (Test::octant_of(ray)) {
-      case 0:
-        return AB_WALK_BVH8_LOOP(0);
-      case 1:
-        return AB_WALK_BVH8_LOOP(1);
-      case 2:
-        return AB_WALK_BVH8_LOOP(2);
-      case 3:
-        return AB_WALK_BVH8_LOOP(3);
-      case 4:
-        return AB_WALK_BVH8_LOOP(4);
-      case 5:
-        return AB_WALK_BVH8_LOOP(5);
-      case 6:
-        return AB_WALK_BVH8_LOOP(6);
-      default:
-        return AB_WALK_BVH8_LOOP(7);
-    }
-  } else {
-    return AB_WALK_BVH8_LOOP(-1);
-  }
-#undef AB_WALK_BVH8_LOOP
 }
 
 }  // namespace ab
