@@ -122,11 +122,13 @@ void add_row(ConfigSummary& s, const json& row, int max_threads) {
   const bool all = row.value("threads_used", 0) == max_threads;
   const double mrays = row.value("rays_per_second", 0.0) / 1e6;
   const json ratio = row.value("ratio_to_embree", json());
-  if (one)
-    s.ratio_one.add(ratio), s.mrays_one.add(mrays),
-        s.cpu_ratio_one.add(row.value("cpu_ratio_to_embree", json()));
   if (all) s.ratio_all.add(ratio), s.mrays_all.add(mrays);
-  if (one) s.nodes.add(row.value("nodes_per_ray", json())), s.prims.add(row.value("prims_per_ray", json()));
+  if (!one) return;
+  s.ratio_one.add(ratio);
+  s.mrays_one.add(mrays);
+  s.cpu_ratio_one.add(row.value("cpu_ratio_to_embree", json()));
+  s.nodes.add(row.value("nodes_per_ray", json()));
+  s.prims.add(row.value("prims_per_ray", json()));
 }
 
 }  // namespace

@@ -38,13 +38,6 @@ double cpu_seconds_per_pass(const benchmark::BenchmarkReporter::Run& r) {
   return r.iterations > 0 ? r.cpu_accumulated_time / double(r.iterations) : r.cpu_accumulated_time;
 }
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t h = v.size() / 2;
-  return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
-}
-
 }  // namespace
 
 int64_t iterations_for(double pass_seconds, double min_time) {
@@ -92,7 +85,7 @@ Timing summarize(const std::vector<benchmark::BenchmarkReporter::Run>& runs, int
     }
     const double s = seconds_per_pass(r);
     if (r.aggregate_name == "median")
-      t.median = s;
+      t.median = s, t.cpu_median = cpu_seconds_per_pass(r);
     else if (r.aggregate_name == "mean")
       t.mean = s;
     else if (r.aggregate_name == "stddev")
@@ -102,9 +95,11 @@ Timing summarize(const std::vector<benchmark::BenchmarkReporter::Run>& runs, int
     else if (r.aggregate_name == "max")
       t.max = s;
   }
-  if (per_rep.size() == 1) t.median = t.mean = t.min = t.max = per_rep.front();  // no aggregates for one run
+  if (per_rep.size() == 1) {  // no aggregates for one run
+    t.median = t.mean = t.min = t.max = per_rep.front();
+    t.cpu_median = t.cpu_samples.front();
+  }
   t.samples = std::move(per_rep);
-  t.cpu_median = median_of(t.cpu_samples);
   return t;
 }
 
