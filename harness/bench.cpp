@@ -10,13 +10,15 @@ namespace ab {
 
 namespace {
 
-/// Google Benchmark reads its flags once; the run passes none (everything is set per case).
+/// Google Benchmark reads its flags once; everything is set per case but the random interleaving of the
+/// repetitions of cases timed together (which leaves a batch of one case as it was).
 void initialize_benchmark_library() {
   static std::once_flag once;
   std::call_once(once, [] {
     static char name[] = "accelbench-run";
-    static char* argv[] = {name, nullptr};
-    int argc = 1;
+    static char interleave[] = "--benchmark_enable_random_interleaving=true";
+    static char* argv[] = {name, interleave, nullptr};
+    int argc = 2;
     benchmark::Initialize(&argc, argv);
   });
 }
@@ -108,31 +110,44 @@ Timing summarize(const std::vector<benchmark::BenchmarkReporter::Run>& runs, int
 Timing BenchTimer::time(const std::string& name, int repetitions, int64_t iterations,
                         const std::function<double()>& pass, double items,
                         const std::map<std::string, double>& counters) {
+  return time_together({BenchCase{name, iterations, pass, items, counters}}, repetitions).front();
+}
+
+std::vector<Timing> BenchTimer::time_together(const std::vector<BenchCase>& cases, int repetitions) {
   std::exception_ptr error;
-  auto body = [&](benchmark::State& state) {
-    try {
-      for (auto _ : state) state.SetIterationTime(pass());
-    } catch (...) {
-      error = std::current_exception();
-      state.SkipWithError("exception in the timed pass");
-      return;
-    }
-    if (items > 0) state.SetItemsProcessed(int64_t(items * double(state.iterations())));
-    for (const auto& [key, value] : counters) state.counters[key] = value;
-  };
-  benchmark::RegisterBenchmark(name.c_str(), body)
-      ->UseManualTime()
-      ->MeasureProcessCPUTime()
-      ->Iterations(std::max<int64_t>(1, iterations))
-      ->Repetitions(std::max(1, repetitions))
-      ->ComputeStatistics("min", stat_min)
-      ->ComputeStatistics("max", stat_max)
-      ->Unit(benchmark::kMillisecond);
+  for (const BenchCase& c : cases) {
+    auto body = [&error, &c](benchmark::State& state) {
+      try {
+        for (auto _ : state) state.SetIterationTime(c.pass());
+      } catch (...) {
+        if (!error) error = std::current_exception();
+        state.SkipWithError("exception in the timed pass");
+        return;
+      }
+      if (c.items > 0) state.SetItemsProcessed(int64_t(c.items * double(state.iterations())));
+      for (const auto& [key, value] : c.counters) state.counters[key] = value;
+    };
+    benchmark::RegisterBenchmark(c.name.c_str(), body)
+        ->UseManualTime()
+        ->MeasureProcessCPUTime()
+        ->Iterations(std::max<int64_t>(1, c.iterations))
+        ->Repetitions(std::max(1, repetitions))
+        ->ComputeStatistics("min", stat_min)
+        ->ComputeStatistics("max", stat_max)
+        ->Unit(benchmark::kMillisecond);
+  }
   collector_->current.clear();
   benchmark::RunSpecifiedBenchmarks(collector_);
   benchmark::ClearRegisteredBenchmarks();
   if (error) std::rethrow_exception(error);
-  return summarize(collector_->current, repetitions, iterations);
+  std::vector<Timing> timings;
+  for (const BenchCase& c : cases) {
+    std::vector<benchmark::BenchmarkReporter::Run> runs;  // this case's, from the interleaved batch
+    for (const auto& r : collector_->current)
+      if (r.run_name.function_name == c.name) runs.push_back(r);
+    timings.push_back(summarize(runs, repetitions, c.iterations));
+  }
+  return timings;
 }
 
 std::string BenchTimer::json() const {

@@ -33,8 +33,16 @@ struct Timing {
 /// Passes per repetition so that a repetition lasts at least `min_time` seconds, given one pass's time.
 int64_t iterations_for(double pass_seconds, double min_time);
 
-/// Runs cases through Google Benchmark one at a time (so that only one structure is alive at a time)
-/// and keeps every reported run.
+/// One case of a batch timed together (BenchTimer::time_together).
+struct BenchCase {
+  std::string name;                        ///< the case's name in gbench.json (unique within the batch)
+  int64_t iterations = 1;                  ///< passes per repetition
+  std::function<double()> pass;            ///< one pass; returns the seconds to count (manual timing)
+  double items = 0.0;                      ///< rays or triangles per pass (items_per_second)
+  std::map<std::string, double> counters;  ///< attached to the case in gbench.json
+};
+
+/// Runs cases through Google Benchmark, one at a time or a batch together, and keeps every reported run.
 class BenchTimer {
  public:
   /// Initializes Google Benchmark (once per process) and an empty collection of runs.
@@ -50,6 +58,11 @@ class BenchTimer {
   Timing time(const std::string& name, int repetitions, int64_t iterations,
               const std::function<double()>& pass, double items = 0.0,
               const std::map<std::string, double>& counters = {});
+
+  /// Times every case of `cases` in one run of the library, `repetitions` times each, the repetitions of
+  /// all cases in a random order (the library's random interleaving), so that a change of the machine's
+  /// load falls on every case alike; one Timing per case, in order. With one case, the same as time().
+  std::vector<Timing> time_together(const std::vector<BenchCase>& cases, int repetitions);
 
   /// Google Benchmark's JSON (context and every run so far), as its JSONReporter writes it.
   std::string json() const;

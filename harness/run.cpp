@@ -60,13 +60,24 @@ class Runner {
                                      json& base);
   void run_config(const Target& target, const SceneSpec& scene, const AccelSpec& spec,
                   std::vector<RaySet>& sets);
+  void run_interleaved(const Target& target, const SceneSpec& scene, std::vector<RaySet>& sets);
   void run_sets(const Accelerator& accel, const Target& target, const std::string& where,
                 const AccelSpec& spec, std::vector<RaySet>& sets, const json& base);
-  void run_ray_set(const Accelerator& accel, const Target& target, const std::string& what,
-                   const AccelSpec& spec, RaySet& set, const json& base);
-  void time_closest(const Accelerator& accel, const std::string& name, RaySet& set,
-                    const std::vector<Hit>& expected, json row);
-  void time_any(const Accelerator& accel, const std::string& name, RaySet& set, bool exact, json row);
+  /// A configuration verified on one ray set and waiting to be timed: its structure, the case name's
+  /// start, its row so far and the hits every timed pass must give again.
+  struct Verified {
+    const Accelerator* accel = nullptr;
+    std::string what;
+    json row;
+    std::vector<Hit> hits;
+    bool exact = false;
+  };
+  Verified verify_set(const Accelerator& accel, const Target& target, const std::string& what,
+                      const AccelSpec& spec, RaySet& set, const json& base);
+  void time_set(std::vector<Verified>& group, RaySet& set);
+  template <typename Out, typename Trace, typename Check>
+  void time_group(const std::vector<Verified>& group, const std::vector<json>& rows, RaySet& set,
+                  const std::string& query, Trace trace, Check check);
   void add_timed_row(json row, const Timing& t, int threads, const std::string& query, uint64_t mismatches);
 
   const Suite& suite_;
@@ -164,10 +175,30 @@ void Runner::run_scene(const SceneSpec& scene) {
   make_references(target, scene.label, suite_.verify, sets, failure_sink());
   report_["scenes"].push_back(scene_entry(scene, target, sets, seconds_since(t0)));
   progress_.step(scene.label + ": references ready");
+  if (suite_.interleave && !suite_.build_only) return run_interleaved(target, scene, sets);
   for (const AccelSpec& spec : suite_.accelerators) {
     if (stopping()) return;
     run_config(target, scene, spec, sets);
   }
+}
+
+/// An interleaved suite's static scene: every configuration built and verified on every ray set first
+/// (all of them alive at once), then each ray set's queries timed with the configurations' repetitions
+/// interleaved (SuiteTimer::time_queries), so that a change of the machine's load falls on all alike.
+void Runner::run_interleaved(const Target& target, const SceneSpec& scene, std::vector<RaySet>& sets) {
+  std::vector<std::unique_ptr<Accelerator>> built;
+  std::vector<std::vector<Verified>> groups(sets.size());
+  for (const AccelSpec& spec : suite_.accelerators) {
+    if (stopping()) return;
+    json base;
+    built.push_back(build(target, scene.label, spec, base));
+    progress_.step(scene.label + " " + spec.label + ": built");
+    for (size_t i = 0; i < sets.size() && !stopping(); ++i)
+      groups[i].push_back(verify_set(*built.back(), target,
+                                     scene.label + " / " + spec.label + " / " + sets[i].spec->label, spec,
+                                     sets[i], base));
+  }
+  for (size_t i = 0; i < sets.size() && !stopping(); ++i) time_set(groups[i], sets[i]);
 }
 
 std::vector<Runner::FrameCase> Runner::frame_cases(const SceneSpec& scene) const {
@@ -290,30 +321,83 @@ void Runner::run_sets(const Accelerator& accel, const Target& target, const std:
   }
   for (RaySet& set : sets) {
     if (stopping()) return;
-    run_ray_set(accel, target, where + " / " + set.spec->label, spec, set, base);
+    std::vector<Verified> group;
+    group.push_back(verify_set(accel, target, where + " / " + set.spec->label, spec, set, base));
+    time_set(group, set);
   }
 }
 
-/// One configuration on one ray set: the counting pass, verified; then the timed passes at every thread
-/// count.
-void Runner::run_ray_set(const Accelerator& accel, const Target& target, const std::string& what,
-                         const AccelSpec& spec, RaySet& set, const json& base) {
-  const bool exact = is_exact(spec.name);  // every structure of the project matches brute byte for byte
-  std::vector<Hit> hits(set.rays.size());
-  const RayCounters c = trace_closest_counted(accel, set.rays, hits, 0);
-  const json v = verify_hits(target, what, spec.name, suite_.verify.reference, set, hits, failure_sink());
-  json detail = v;
+/// One configuration on one ray set: the counting pass and its verification (the rows' counts and
+/// checks); the timing is time_set's.
+Runner::Verified Runner::verify_set(const Accelerator& accel, const Target& target, const std::string& what,
+                                    const AccelSpec& spec, RaySet& set, const json& base) {
+  Verified v{&accel, what, base, std::vector<Hit>(set.rays.size()), is_exact(spec.name)};
+  const RayCounters c = trace_closest_counted(accel, set.rays, v.hits, 0);
+  const json checked =
+      verify_hits(target, what, spec.name, suite_.verify.reference, set, v.hits, failure_sink());
+  json detail = checked;
   detail["rays"] = set.spec->label;
   report_["builds"].back()["verification"].push_back(detail);
-  json row = base;
-  row.update(v);
+  v.row.update(checked);
   progress_.step(what + ": verified");
-  row["rays"] = set.spec->label;
-  row["ray_kind"] = set.spec->kind.empty() ? json() : json(set.spec->kind);
-  row["ray_count"] = set.rays.size();
-  if (exact) row.update(per_ray_fields(c, set.rays.size()));
-  time_closest(accel, what, set, hits, row);
-  if (set.spec->any_hit) time_any(accel, what, set, exact, row);
+  v.row["rays"] = set.spec->label;
+  v.row["ray_kind"] = set.spec->kind.empty() ? json() : json(set.spec->kind);
+  v.row["ray_count"] = set.rays.size();
+  // every structure of the project matches brute byte for byte: its per-ray counts are exact too
+  if (v.exact) v.row.update(per_ray_fields(c, set.rays.size()));
+  return v;
+}
+
+/// The timed passes of a group of verified configurations on one ray set, at every thread count, the
+/// group's repetitions interleaved: closest hit, then any hit when the set asks for it (its own counting
+/// pass first, on one thread: counters never run on the timed path).
+void Runner::time_set(std::vector<Verified>& group, RaySet& set) {
+  std::vector<json> rows;
+  for (const Verified& v : group) rows.push_back(v.row);
+  time_group<Hit>(
+      group, rows, set, "closest",
+      [&](const Accelerator& a, std::vector<Hit>& out, int threads) {
+        trace_closest(a, set.rays, out, threads);
+      },
+      [&](const std::string& name, const Verified& v, const std::vector<Hit>& out) {
+        return check_timed_hits(name, v.hits, out, failure_sink());
+      });
+  if (!set.spec->any_hit) return;
+  for (size_t k = 0; k < group.size(); ++k) {
+    if (!group[k].exact) continue;
+    std::vector<uint8_t> counted(set.rays.size());
+    RayCounters c;
+    group[k].accel->occluded_counted(set.rays, counted, c);
+    rows[k].update(per_ray_fields(c, set.rays.size()));
+  }
+  time_group<uint8_t>(
+      group, rows, set, "any",
+      [&](const Accelerator& a, std::vector<uint8_t>& out, int threads) {
+        trace_occluded(a, set.rays, out, threads);
+      },
+      [&](const std::string& name, const Verified& v, const std::vector<uint8_t>& out) {
+        return check_any_hits(name, v.exact, out, set, failure_sink());
+      });
+}
+
+/// One query of a group at every thread count: `trace` fills a structure's answers (Out per ray), `check`
+/// counts how many differ from the verified ones; one row per configuration and thread count.
+template <typename Out, typename Trace, typename Check>
+void Runner::time_group(const std::vector<Verified>& group, const std::vector<json>& rows, RaySet& set,
+                        const std::string& query, Trace trace, Check check) {
+  for (int threads : suite_.threads) {
+    if (stopping()) return;
+    std::vector<std::vector<Out>> outs(group.size(), std::vector<Out>(set.rays.size()));
+    std::vector<SuiteTimer::Query> queries;
+    for (size_t k = 0; k < group.size(); ++k)
+      queries.push_back({group[k].what + "/" + query + "/threads:" + std::to_string(threads), set.rays.size(),
+                         [&, k, threads] { trace(*group[k].accel, outs[k], threads); }});
+    const std::vector<Timing> timings = timer_.time_queries(queries);
+    for (size_t k = 0; k < group.size(); ++k) {
+      add_timed_row(rows[k], timings[k], threads, query, check(queries[k].name, group[k], outs[k]));
+      progress_.step(queries[k].name);
+    }
+  }
 }
 
 void Runner::add_timed_row(json row, const Timing& t, int threads, const std::string& query,
@@ -326,37 +410,6 @@ void Runner::add_timed_row(json row, const Timing& t, int threads, const std::st
   if (mismatches && (query == "closest" || is_exact(row["accelerator"].get<std::string>())))
     row["verified"] = false;
   report_["results"].push_back(row);
-}
-
-void Runner::time_closest(const Accelerator& accel, const std::string& name, RaySet& set,
-                          const std::vector<Hit>& expected, json row) {
-  for (int threads : suite_.threads) {
-    if (stopping()) return;
-    std::vector<Hit> out(set.rays.size());
-    const std::string case_name = name + "/closest/threads:" + std::to_string(threads);
-    const Timing t =
-        timer_.time_query(case_name, set.rays.size(), [&] { trace_closest(accel, set.rays, out, threads); });
-    add_timed_row(row, t, threads, "closest", check_timed_hits(case_name, expected, out, failure_sink()));
-    progress_.step(case_name);
-  }
-}
-
-void Runner::time_any(const Accelerator& accel, const std::string& name, RaySet& set, bool exact, json row) {
-  if (exact) {  // the any-hit counting pass (one thread; counters never run on the timed path)
-    std::vector<uint8_t> counted(set.rays.size());
-    RayCounters c;
-    accel.occluded_counted(set.rays, counted, c);
-    row.update(per_ray_fields(c, set.rays.size()));
-  }
-  for (int threads : suite_.threads) {
-    if (stopping()) return;
-    std::vector<uint8_t> out(set.rays.size());
-    const std::string case_name = name + "/any/threads:" + std::to_string(threads);
-    const Timing t =
-        timer_.time_query(case_name, set.rays.size(), [&] { trace_occluded(accel, set.rays, out, threads); });
-    add_timed_row(row, t, threads, "any", check_any_hits(case_name, exact, out, set, failure_sink()));
-    progress_.step(case_name);
-  }
 }
 
 }  // namespace

@@ -319,6 +319,7 @@ void parse_settings(const json& j, const Where& w, Suite& suite) {
     suite.min_time = j["min_time"].get<double>();
   }
   if (j.contains("build_only")) suite.build_only = read_bool(j["build_only"], w.at("build_only"));
+  if (j.contains("interleave")) suite.interleave = read_bool(j["interleave"], w.at("interleave"));
   if (j.contains("threads")) suite.threads = parse_threads(j["threads"], w.at("threads"));
   if (j.contains("verify")) suite.verify = parse_verify(j["verify"], w.at("verify"));
 }
@@ -329,7 +330,7 @@ Suite parse_suite(const nlohmann::json& j, const std::string& source, const std:
   const Where root{source, ""};
   check_keys(j, root,
              {"name", "description", "seed", "repetitions", "build_repetitions", "warmup", "min_time",
-              "threads", "build_only", "scenes", "accelerators", "rays", "verify"});
+              "threads", "build_only", "interleave", "scenes", "accelerators", "rays", "verify"});
   Suite suite;
   suite.source = source;
   suite.json = j;

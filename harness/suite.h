@@ -68,7 +68,10 @@ struct Suite {
   double min_time = 0.02;   ///< seconds each timed repetition lasts at least (more iterations if faster)
   uint64_t seed = 1;        ///< seed of the ray sets
   bool build_only = false;  ///< measure builds only (no ray sets)
-  VerifySpec verify;        ///< how results are verified
+  /// Time each ray set's queries with every configuration's repetitions interleaved (all of a scene's
+  /// configurations alive at once) instead of one configuration after another.
+  bool interleave = false;
+  VerifySpec verify;  ///< how results are verified
 };
 
 /// Parses a suite. `source` names it in errors; relative paths are resolved against `base_dir`.

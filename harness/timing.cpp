@@ -16,18 +16,26 @@ Timing SuiteTimer::time_build(const std::string& name, double triangles,
 }
 
 Timing SuiteTimer::time_query(const std::string& name, size_t rays, const std::function<void()>& work) {
-  auto pass = [&] {
-    const auto t0 = std::chrono::steady_clock::now();
-    work();
-    return seconds_since(t0);
-  };
-  double estimate = 0.0;  // the fastest warm-up pass (the least disturbed by other processes)
-  for (int i = 0; i < suite_.warmup; ++i) {
-    const double s = pass();
-    estimate = i == 0 ? s : std::min(estimate, s);
+  return time_queries({Query{name, rays, work}}).front();
+}
+
+std::vector<Timing> SuiteTimer::time_queries(const std::vector<Query>& queries) {
+  std::vector<BenchCase> cases;
+  for (const Query& q : queries) {
+    auto pass = [work = q.work] {
+      const auto t0 = std::chrono::steady_clock::now();
+      work();
+      return seconds_since(t0);
+    };
+    double estimate = 0.0;  // the fastest warm-up pass (the least disturbed by other processes)
+    for (int i = 0; i < suite_.warmup; ++i) {
+      const double s = pass();
+      estimate = i == 0 ? s : std::min(estimate, s);
+    }
+    const int64_t iterations = estimate > 0 ? iterations_for(estimate, suite_.min_time) : 1;
+    cases.push_back(BenchCase{q.name, iterations, pass, double(q.rays), {}});
   }
-  const int64_t iterations = estimate > 0 ? iterations_for(estimate, suite_.min_time) : 1;
-  return timer_.time(name, suite_.repetitions, iterations, pass, double(rays));
+  return timer_.time_together(cases, suite_.repetitions);
 }
 
 nlohmann::json timing_json(const Timing& t) {

@@ -7,6 +7,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "harness/bench.h"
 #include "harness/suite.h"
@@ -27,6 +28,15 @@ class SuiteTimer {
   /// Times `work` (one pass over `rays` rays): warm-up passes first (untimed), then repetitions of enough
   /// passes to last min_time, the count estimated from the fastest warm-up pass.
   Timing time_query(const std::string& name, size_t rays, const std::function<void()>& work);
+  /// One query case of a batch (time_queries).
+  struct Query {
+    std::string name;            ///< the case's name
+    size_t rays = 0;             ///< rays per pass
+    std::function<void()> work;  ///< one pass
+  };
+  /// Times several queries as time_query times one (each its own warm-up and pass count), their
+  /// repetitions interleaved in one run (BenchTimer::time_together); one Timing per query, in order.
+  std::vector<Timing> time_queries(const std::vector<Query>& queries);
   /// Google Benchmark's JSON of every case timed so far.
   std::string gbench_json() const { return timer_.json(); }
 
