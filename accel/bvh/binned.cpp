@@ -9,6 +9,7 @@
 #include <array>
 #include <bit>
 #include <memory>
+#include <vector>
 
 #include "accel/bvh/binned_split.h"
 #include "accel/bvh/build.h"
@@ -128,26 +129,73 @@ void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& 
   }
 }
 
-/// Partitions [b, e) stably into [b, m), the primitives whose bin on `axis` lies below `position` (m - b
-/// of them, known from the bins), and [m, e), from refs into out, gathering each side's centroid bounds.
-/// Branch-free: each reference is written at the cursor of its side (a conditional move, not a
-/// mispredicted branch).
-void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis,
-                              int position, const BinMapping& map, Box4& left_c, Box4& right_c) {
-  const float lo = map.lo[axis], scale = map.scale[axis];
+/// Which side of the split a reference goes to: its bin on the split's axis (the binning's arithmetic on
+/// lane `axis` of center(), bit for bit) below the split's position.
+struct SideTest {
+  float lo, scale;
+  int last, position, axis;
+
+  SideTest(const BinMapping& map, int a, int pos)
+      : lo(map.lo[a]), scale(map.scale[a]), last(map.bins - 1), position(pos), axis(a) {}
+  bool left(const BinRef& ref) const {
+    const float c_axis = (ref.lo[axis] + ref.hi[axis]) * 0.5f;
+    return std::clamp(int((c_axis - lo) * scale), 0, last) < position;
+  }
+};
+
+/// The centroid bounds of both sides of a partition.
+struct SideBounds {
+  Box4 left = Box4::empty(), right = Box4::empty();
+};
+
+/// Moves refs [b, e) into out, the left ones from cursor l on and the others from cursor r on, in order,
+/// and returns both sides' centroid bounds. Branch-free: each reference is written at the cursor of its
+/// side (a conditional move, not a mispredicted branch); the bounds are kept in registers.
+SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t e, uint32_t l, uint32_t r,
+                           const SideTest& side) {
   const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
-  uint32_t l = b, r = m;
+  Box4 lc = Box4::empty(), rc = Box4::empty();
   for (uint32_t k = b; k < e; ++k) {
     const BinRef& ref = refs[k];
-    const float c_axis = (ref.lo[axis] + ref.hi[axis]) * 0.5f;  // lane `axis` of center(), bit for bit
-    const bool left = std::clamp(int((c_axis - lo) * scale), 0, map.bins - 1) < position;
+    const bool left = side.left(ref);
     out[left ? l : r] = ref;
     l += left;
     r += !left;
     const __m128 c = ref.center(), mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
-    left_c.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
-    right_c.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
+    lc.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
+    rc.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
   }
+  return {lc, rc};
+}
+
+/// Partitions [b, e) stably into [b, m), the primitives whose bin on `axis` lies below `position` (m - b
+/// of them, known from the bins), and [m, e), from refs into out, gathering each side's centroid bounds.
+/// Large ranges are cut into blocks of kGrain: one parallel pass counts each block's left references, a
+/// prefix sum gives every block its two cursors, and a second parallel pass moves them (the same order as
+/// the serial pass, and the bounds are exact min / max, so the result does not depend on the threads).
+void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis,
+                              int position, const BinMapping& map, Box4& left_c, Box4& right_c) {
+  const SideTest side(map, axis, position);
+  if (e - b < kParallelReduceThreshold) {
+    const SideBounds s = partition_range(refs, out, b, e, b, m, side);
+    return left_c.extend(s.left), right_c.extend(s.right);
+  }
+  const size_t blocks = (e - b + kGrain - 1) / kGrain;
+  auto block_end = [&](size_t i) { return uint32_t(std::min<size_t>(e, b + (i + 1) * kGrain)); };
+  std::vector<uint32_t> lefts(blocks + 1, 0);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
+    uint32_t n = 0;
+    for (uint32_t k = uint32_t(b + i * kGrain), end = block_end(i); k < end; ++k) n += side.left(refs[k]);
+    lefts[i + 1] = n;
+  });
+  for (size_t i = 0; i < blocks; ++i) lefts[i + 1] += lefts[i];
+  std::vector<SideBounds> bounds(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
+    const uint32_t first = uint32_t(b + i * kGrain);
+    bounds[i] =
+        partition_range(refs, out, first, block_end(i), b + lefts[i], m + (first - b - lefts[i]), side);
+  });
+  for (const SideBounds& s : bounds) left_c.extend(s.left), right_c.extend(s.right);
 }
 
 }  // namespace

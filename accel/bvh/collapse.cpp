@@ -27,22 +27,29 @@ class GreedyChildren {
  public:
   explicit GreedyChildren(const BvhNodeArray& binary) : binary_(binary) {}
 
-  /// Children of binary interior node b.
+  /// Children of binary interior node b. Each child's area is computed once, when it becomes a child (a leaf
+  /// counts as area -1, never opened).
   Kids children_of(uint32_t b) const {
     Kids kids;
-    kids.insert(0, binary_[b].offset);
-    kids.insert(1, binary_[b].offset + 1);
+    std::array<float, Bvh8Node::kWidth> area{};
+    auto area_of = [&](uint32_t id) { return binary_[id].is_leaf() ? -1.0f : binary_[id].box().area(); };
+    auto put = [&](size_t k, uint32_t id) {
+      for (size_t j = kids.size(); j > k; --j) area[j] = area[j - 1];
+      kids.insert(k, id);
+      area[k] = area_of(id);
+    };
+    put(0, binary_[b].offset);
+    put(1, binary_[b].offset + 1);
     while (kids.size() < size_t(Bvh8Node::kWidth)) {
       int pick = -1;
       float pick_area = -1.0f;
-      for (size_t k = 0; k < kids.size(); ++k) {
-        const BvhNode& n = binary_[kids[k]];
-        if (!n.is_leaf() && n.box().area() > pick_area) pick = int(k), pick_area = n.box().area();
-      }
+      for (size_t k = 0; k < kids.size(); ++k)
+        if (area[k] > pick_area) pick = int(k), pick_area = area[k];
       if (pick < 0) break;
       const uint32_t opened = kids[size_t(pick)];
       kids.id[size_t(pick)] = binary_[opened].offset;
-      kids.insert(size_t(pick) + 1, binary_[opened].offset + 1);
+      area[size_t(pick)] = area_of(binary_[opened].offset);
+      put(size_t(pick) + 1, binary_[opened].offset + 1);
     }
     return kids;
   }
