@@ -1,33 +1,72 @@
 #include "accel/core/clip.h"
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 
 namespace ab {
 
-void clip_polygon(ClipPolygon& poly, const vec3& normal, float offset) {
-  if (poly.n == 0) return;
-  ClipPolygon out;
-  for (int i = 0; i < poly.n; ++i) {
-    const vec3& a = poly.v[i];
-    const vec3& b = poly.v[(i + 1) % poly.n];
-    const float da = glm::dot(normal, a) - offset;
-    const float db = glm::dot(normal, b) - offset;
-    if (da <= 0.0f && out.n < static_cast<int>(out.v.size())) out.v[out.n++] = a;
+namespace {
+
+/// One Sutherland and Hodgman (1974) step: the part of in with dot(normal, p) <= offset into out. Returns
+/// false, out untouched, when every point of in already lies on that side: the step would return in
+/// unchanged, point for point, so the caller keeps in (no copy). The distances are computed once per point.
+bool clip_step(const ClipPolygon& in, const vec3& normal, float offset, ClipPolygon& out) {
+  std::array<float, std::tuple_size_v<decltype(in.v)>> d;
+  bool inside = true, outside = true;
+  for (int i = 0; i < in.n; ++i) {
+    d[i] = glm::dot(normal, in.v[i]) - offset;
+    inside = inside && d[i] <= 0.0f;
+    outside = outside && d[i] > 0.0f;
+  }
+  if (inside) return false;
+  out.n = 0;
+  if (outside) return true;
+  const int cap = static_cast<int>(out.v.size());
+  for (int i = 0; i < in.n; ++i) {
+    const int j = i + 1 == in.n ? 0 : i + 1;
+    const float da = d[i], db = d[j];
+    if (da <= 0.0f && out.n < cap) out.v[out.n++] = in.v[i];
     if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) {
       const float s = da / (da - db);
-      if (out.n < static_cast<int>(out.v.size())) out.v[out.n++] = a + s * (b - a);
+      if (out.n < cap) out.v[out.n++] = in.v[i] + s * (in.v[j] - in.v[i]);
     }
   }
-  poly = out;
+  return true;
+}
+
+/// Copies the n points of from into to.
+void assign(ClipPolygon& to, const ClipPolygon& from) {
+  std::copy(from.v.begin(), from.v.begin() + from.n, to.v.begin());
+  to.n = from.n;
+}
+
+/// Clips poly by the box's six axis planes, ping-ponging between poly and spare: returns the one holding
+/// the result. A plane the polygon lies inside is skipped (clip_step returns false).
+const ClipPolygon& clip_to_box(ClipPolygon& poly, ClipPolygon& spare, const AABB& box) {
+  ClipPolygon* cur = &poly;
+  ClipPolygon* other = &spare;
+  for (int a = 0; a < 3 && cur->n > 0; ++a) {
+    vec3 axis(0.0f);
+    axis[a] = 1.0f;
+    if (clip_step(*cur, axis, box.hi[a], *other)) std::swap(cur, other);
+    if (cur->n > 0 && clip_step(*cur, -axis, -box.lo[a], *other)) std::swap(cur, other);
+  }
+  return *cur;
+}
+
+}  // namespace
+
+void clip_polygon(ClipPolygon& poly, const vec3& normal, float offset) {
+  ClipPolygon out;
+  if (clip_step(poly, normal, offset, out)) assign(poly, out);
 }
 
 void clip_polygon_to_box(ClipPolygon& poly, const AABB& box) {
-  for (int a = 0; a < 3 && poly.n > 0; ++a) {
-    vec3 axis(0.0f);
-    axis[a] = 1.0f;
-    clip_polygon(poly, axis, box.hi[a]);
-    clip_polygon(poly, -axis, -box.lo[a]);
-  }
+  ClipPolygon spare;
+  const ClipPolygon& out = clip_to_box(poly, spare, box);
+  if (&out != &poly) assign(poly, out);
 }
 
 AABB clipped_triangle_bounds(const Triangle& tri, const AABB& box) {
@@ -35,14 +74,14 @@ AABB clipped_triangle_bounds(const Triangle& tri, const AABB& box) {
   if (!tb.overlaps(box)) return AABB{};
   // Fully inside: no clipping needed.
   if (box.contains(tb.lo) && box.contains(tb.hi)) return tb;
-  ClipPolygon poly;
+  ClipPolygon poly, spare;
   poly.v[0] = tri.v0;
   poly.v[1] = tri.v1;
   poly.v[2] = tri.v2;
   poly.n = 3;
-  clip_polygon_to_box(poly, box);
+  const ClipPolygon& clipped = clip_to_box(poly, spare, box);
   AABB out;
-  for (int i = 0; i < poly.n; ++i) out.extend(poly.v[i]);
+  for (int i = 0; i < clipped.n; ++i) out.extend(clipped.v[i]);
   // Clipped points are computed with rounding; keep the result inside the box.
   return AABB::intersection(out, box);
 }
