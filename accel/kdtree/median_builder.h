@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "accel/common/conservative_insertion.h"
+#include "accel/common/ref_frontier.h"
 #include "accel/common/refine_rules.h"
 #include "accel/kdtree/box_node.h"
 #include "accel/kdtree/config.h"
@@ -38,6 +39,7 @@ class KdMedianBuilder {
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = KdBuffer{};
+      count_frontier_root(ledger, ids.size());
       build_node(make_box_root(prims_, ids, box), {0, 0, budget}, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
@@ -88,7 +90,7 @@ class KdMedianBuilder {
       return make_leaf(node.ids, out);
     node = KdBoxNode{};
     const size_t all = left.ids.size() + right.ids.size();
-    if (ledger_) ledger_->add_children(all);
+    count_frontier_split(ledger_, n, left.ids.size(), right.ids.size());
     const Path lp{depth + 1, path.bad, path.budget.share(left.ids.size(), all)};
     const Path rp{depth + 1, path.bad, path.budget.share(right.ids.size(), all)};
     const size_t self = out.nodes.size();
@@ -111,7 +113,6 @@ class KdMedianBuilder {
 
   /// Appends a leaf of ids (in the node's order, which is ascending: the root's, kept by every partition).
   void make_leaf(const std::vector<uint32_t>& ids, KdBuffer& out) const {
-    if (ledger_) ledger_->add_leaf(ids.size());
     out.nodes.push_back(out.make_leaf(ids));
   }
 

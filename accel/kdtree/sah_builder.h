@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "accel/common/conservative_insertion.h"
+#include "accel/common/ref_frontier.h"
 #include "accel/common/refine_rules.h"
 #include "accel/common/sah.h"
 #include "accel/kdtree/config.h"
@@ -60,6 +61,7 @@ class KdSahBuilder {
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = KdBuffer{};
+      count_frontier_root(ledger, ids.size());
       build_node(make_box_root(prims_, ids, box), {0, budget}, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
@@ -90,7 +92,6 @@ class KdSahBuilder {
 
   /// Appends a leaf of ids.
   void make_leaf(const std::vector<uint32_t>& ids, KdBuffer& out) const {
-    if (ledger_) ledger_->add_leaf(ids.size());
     out.nodes.push_back(out.make_leaf(ids));
   }
 
@@ -129,7 +130,7 @@ class KdSahBuilder {
       if (nl != n) ids = merged_ids(ids, right.ids);
       return make_leaf(ids, out);
     }
-    if (ledger_) ledger_->add_children(nl + nr);
+    count_frontier_split(ledger_, n, nl, nr);
     const Path lp{path.depth + 1, path.budget.share(nl, nl + nr)};
     const Path rp{path.depth + 1, path.budget.share(nr, nl + nr)};
     const size_t self = out.nodes.size();
