@@ -120,6 +120,41 @@ TEST(Bvh8, EnteredChildrenAreRankedFarthestFirst) {
   }
 }
 
+TEST(Bvh8, StackedChildrenComeBackNearestFirst) {
+  // stack_entered_children returns one entered child and stacks the others: sorted, the returned one is the
+  // nearest and the stack pops the rest nearer first; unsorted, every entered lane once. Two children take
+  // their own path (one compare), more the ranking.
+  std::mt19937 rng(11);
+  Bvh8Node node{};
+  for (int k = 0; k < 8; ++k) node.child[k] = uint32_t(100 + k), node.count[k] = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    unsigned mask = rng() & 0xffu;
+    if (trial % 2 == 0) mask = (1u << (rng() % 8)) | (1u << (rng() % 8));  // two lanes often
+    if (std::popcount(mask) < 2) mask |= 3u << (rng() % 7);
+    alignas(32) float t[8];
+    for (float& x : t) x = rng() % 5 == 0 ? 1.0f : uniform(rng, 0, 4);  // ties too
+    for (const bool sorted : {true, false}) {
+      Bvh8Stack stack;
+      const Bvh8StackEntry next =
+          sorted ? stack_entered_children<true>(&node, node, mask, t, stack, nullptr, 0)
+                 : stack_entered_children<false>(&node, node, mask, t, stack, nullptr, 0);
+      unsigned seen = 1u << (next.child - 100);
+      float last = next.t;
+      for (Bvh8StackEntry e; stack.pop(kInf, e);) {
+        const unsigned lane = e.child - 100;
+        ASSERT_FALSE(seen >> lane & 1) << trial;
+        seen |= 1u << lane;
+        EXPECT_EQ(bits(e.t), bits(t[lane]));
+        if (sorted) {  // within the ranking key's three dropped low bits distances count as ties
+          EXPECT_LE(bits(last) & ~7u, bits(e.t) & ~7u) << trial;
+        }
+        last = e.t;
+      }
+      EXPECT_EQ(seen, mask) << trial;
+    }
+  }
+}
+
 TEST(Bvh8, FourLaneKernelGivesTheScalarKernelsBits) {
   const Mesh mesh = adversarial_mesh(6);
   std::vector<Triangle> tris;
