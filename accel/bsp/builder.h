@@ -20,6 +20,7 @@
 #include "accel/bsp/cell.h"
 #include "accel/bsp/config.h"
 #include "accel/bsp/node.h"
+#include "accel/common/ref_frontier.h"
 #include "accel/common/refine_rules.h"
 #include "accel/core/clip.h"
 
@@ -45,7 +46,7 @@ class BspBuilder {
       }
       out = BspBuffer{};
       NodePrims root = gather_root(ids, box);
-      if (ledger) ledger->add_leaf(root.size());
+      count_frontier_root(ledger, root.size());
       build_node(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, 0, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
@@ -198,19 +199,6 @@ class BspBuilder {
   /// Appends a leaf of the node's primitives.
   void make_leaf(const NodePrims& np, BspBuffer& out) const { out.nodes.push_back(out.make_leaf(np.ids)); }
 
-  /// Counts a split into the first attempt's ledger. Its leaf count is the references of the frontier (the
-  /// root's, and each split's children's beyond their parent's), not of the leaves made so far: the same
-  /// sum when the tree is done (at least the leaves' references: a child drops the primitives whose part
-  /// misses its cell), but it only grows, and passes ref_budget x N as soon as the splits made so far have
-  /// copied that many, so a tree over the budget is abandoned after its first few duplicating levels
-  /// (large overlapping triangles: every split copies most of them) instead of after ref_budget x N
-  /// references of finished leaves. Whether it passes is still a property of the tree alone.
-  void count_split(size_t n, size_t nl, size_t nr) const {
-    if (!ledger_) return;
-    ledger_->add_children(nl + nr);
-    ledger_->add_leaf(nl + nr > n ? nl + nr - n : 0);
-  }
-
   /// Builds the node of primitives np in cell into out; `at`: its node in the memo (memoized_decision).
   void build_node(NodePrims&& np, const ConvexCell& cell, Depth depth, uint32_t at, BspBuffer& out) const {
     if (ledger_ && ledger_->over()) return out.nodes.push_back(kAbandoned);
@@ -223,7 +211,7 @@ class BspBuilder {
         !depth.budget.allows(nl + nr)) {
       return make_leaf(np, out);
     }
-    count_split(n, nl, nr);
+    count_frontier_split(ledger_, n, nl, nr);
     const ConvexCell lcell = cell.part(d.plane, true), rcell = cell.part(d.plane, false);
     NodePrims left = child_prims(np, sides, 1, d.plane, lcell);
     NodePrims right = child_prims(np, sides, 2, d.plane, rcell);

@@ -4,7 +4,8 @@
 // it only grows, and passes ref_budget x N as soon as the splits made so far have copied that many: a tree
 // over the budget is abandoned after its first few duplicating levels (large overlapping triangles: every
 // split copies most of them) instead of after ref_budget x N references of finished leaves. Whether it
-// passes is still a property of the tree alone (the bsp's count_split, bsp6).
+// passes is still a property of the tree alone. The k-d trees and the bsp count their first attempts this
+// way.
 #pragma once
 
 #include <cstddef>
