@@ -109,7 +109,7 @@ TEST(BspCell, APlaneThatDoesNotCutLeavesTheCellWhole) {
   const ConvexCell half = box.part(diagonal, true);
   // The same plane again: its face is not duplicated and the other side is empty.
   EXPECT_FLOAT_EQ(half.part(diagonal, true).area(), half.area());
-  EXPECT_EQ(half.part(diagonal, true).faces().size(), half.faces().size());
+  EXPECT_EQ(half.part(diagonal, true).face_count(), half.face_count());
   EXPECT_EQ(half.part(diagonal, false).area(), 0.0f);
   const CellSurface surface(half);
   const float d[1] = {diagonal.d};

@@ -13,6 +13,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <span>
 #include <type_traits>
 #include <vector>
 
@@ -212,7 +213,7 @@ class BspBuilder {
       return make_leaf(np, out);
     }
     count_frontier_split(ledger_, n, nl, nr);
-    const ConvexCell lcell = cell.part(d.plane, true), rcell = cell.part(d.plane, false);
+    const auto [lcell, rcell] = cell.parts(d.plane);
     NodePrims left = child_prims(np, sides, 1, d.plane, lcell);
     NodePrims right = child_prims(np, sides, 2, d.plane, rcell);
     np = NodePrims{};
@@ -417,14 +418,19 @@ class BspBuilder {
     float cell_lo, cell_hi;
     surface.extent(dir, cell_lo, cell_hi);
     const float min_gap = (cell_hi - cell_lo) / float(config_.bins);
-    al.resize(d.size());
-    ar.resize(d.size());
-    surface.areas(dir, d, al.data(), ar.data());
+    size_t m = 0;  // the planes kept, moved to the front before their areas are computed
     for (size_t j = 0; j < d.size(); ++j) {
       if (nl[j] == 0 && !(d[j] - cell_lo >= min_gap)) continue;
       if (nr[j] == 0 && !(cell_hi - d[j] >= min_gap)) continue;
-      keep(ch, BspPlane{dir, d[j]}, cell_area, al[j], ar[j], nl[j], nr[j], n, shave_ok);
+      d[m] = d[j];
+      nl[m] = nl[j];
+      nr[m++] = nr[j];
     }
+    al.resize(m);
+    ar.resize(m);
+    surface.areas(dir, std::span<const float>(d.data(), m), al.data(), ar.data());
+    for (size_t j = 0; j < m; ++j)
+      keep(ch, BspPlane{dir, d[j]}, cell_area, al[j], ar[j], nl[j], nr[j], n, shave_ok);
   }
 
   /// Planes at the start and end of the extents of `samples` primitives spread over the node (every one

@@ -9,13 +9,15 @@
 #include <array>
 #include <cmath>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "accel/bsp/candidates.h"
 
 namespace ab {
 
-/// A convex polyhedron given by its faces (each a convex polygon, counter-clockwise seen from outside).
+/// A convex polyhedron given by its faces (each a convex polygon, counter-clockwise seen from outside), kept
+/// in one flat array of vertices with each face's first index (two allocations per cell, not one per face).
 class ConvexCell {
  public:
   /// The six faces of box b.
@@ -27,18 +29,30 @@ class ConvexCell {
     };
     const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
                              {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-    for (const auto& q : quads) c.faces_.push_back({corner(q[0]), corner(q[1]), corner(q[2]), corner(q[3])});
+    c.verts_.reserve(24);
+    for (const auto& q : quads) {
+      for (int k : q) c.verts_.push_back(corner(k));
+      c.starts_.push_back(uint32_t(c.verts_.size()));
+    }
     c.box_ = true;
+    c.bounds_ = b;
     return c;
   }
 
   /// True when the cell is its bounding box (the root's, cut by axis planes only).
   bool is_box() const { return box_; }
 
+  /// Number of faces.
+  size_t face_count() const { return starts_.size() - 1; }
+  /// Face k's vertices.
+  std::span<const vec3> face(size_t k) const {
+    return {verts_.data() + starts_[k], verts_.data() + starts_[k + 1]};
+  }
+
   /// Surface area.
   float area() const {
     float a = 0.0f;
-    for (const auto& f : faces_) a += glm::length(vector_area(f));
+    for (size_t k = 0; k < face_count(); ++k) a += glm::length(vector_area(face(k)));
     return a;
   }
 
@@ -47,7 +61,8 @@ class ConvexCell {
   void areas(const BspPlane& p, float& below, float& above) const {
     vec3 sum_below(0.0f), sum_above(0.0f);
     below = above = 0.0f;
-    for (const auto& f : faces_) {
+    for (size_t k = 0; k < face_count(); ++k) {
+      const std::span<const vec3> f = face(k);
       VectorAreaSum vb, va;
       for (size_t i = 0; i < f.size(); ++i) {
         const vec3& a = f[i];
@@ -71,51 +86,79 @@ class ConvexCell {
     above += glm::length(sum_above);
   }
 
-  /// Faces (for CellSurface).
-  const std::vector<std::vector<vec3>>& faces() const { return faces_; }
+  /// Every face's vertices, face after face (for CellSurface).
+  std::span<const vec3> vertices() const { return verts_; }
 
   /// Bounds of the cell's vertices.
-  AABB bounds() const {
-    AABB b;
-    for (const auto& f : faces_)
-      for (const vec3& v : f) b.extend(v);
-    return b;
-  }
+  const AABB& bounds() const { return bounds_; }
 
   /// The part on one side of plane, closed by the cut face.
   /// A plane that does not cut the cell (every vertex within rounding of it or on one side, for example
   /// one of the cell's own faces) leaves the whole cell on that side and nothing on the other, so no
   /// face is ever duplicated.
   ConvexCell part(const BspPlane& p, bool below) const {
-    bool removes = false, keeps = false;
-    for (const auto& f : faces_)
-      for (const vec3& v : f) {
-        const float s = below ? p.distance(v) : -p.distance(v);
-        const float tol = 1e-6f * (1.0f + glm::length(v));
-        removes |= s > tol;
-        keeps |= s < -tol;
-      }
+    std::pair<ConvexCell, ConvexCell> both = parts(p, below ? kBelow : kAbove);
+    return below ? std::move(both.first) : std::move(both.second);
+  }
+  /// Both parts (below, above) of part(): the vertices' distances from the plane computed once.
+  std::pair<ConvexCell, ConvexCell> parts(const BspPlane& p) const { return parts(p, kBelow | kAbove); }
+
+ private:
+  static constexpr int kBelow = 1, kAbove = 2;
+
+  /// The parts of part() on the sides in `which` (the others left empty).
+  std::pair<ConvexCell, ConvexCell> parts(const BspPlane& p, int which) const {
+    thread_local std::vector<float> dist, tol;
+    dist.resize(verts_.size());
+    tol.resize(verts_.size());
+    bool pos = false, neg = false;  // some vertex clearly above, clearly below
+    for (size_t i = 0; i < verts_.size(); ++i) {
+      dist[i] = p.distance(verts_[i]);
+      tol[i] = 1e-6f * (1.0f + glm::length(verts_[i]));
+      pos |= dist[i] > tol[i];
+      neg |= dist[i] < -tol[i];
+    }
+    std::pair<ConvexCell, ConvexCell> out;
+    if (which & kBelow) out.first = side(p, true, neg, pos, dist);
+    if (which & kAbove) out.second = side(p, false, pos, neg, dist);
+    return out;
+  }
+
+  /// The part on one side: `keeps` (some vertex clearly on that side), `removes` (some on the other).
+  ConvexCell side(const BspPlane& p, bool below, bool keeps, bool removes,
+                  const std::vector<float>& dist) const {
     if (!keeps) return ConvexCell{};
     if (!removes) return *this;
     if (const int a = exact_axis(p); box_ && a >= 0) {
       // A box cut by an axis plane is a box: the k-d tree's split of the box instead of a polyhedron clip.
-      AABB b = bounds();
+      AABB b = bounds_;
       (below ? b.hi : b.lo)[a] = p.d;
       return from_box(b);
     }
     ConvexCell out;
-    std::vector<vec3> cut;
-    for (const auto& f : faces_) {
-      std::vector<vec3> g = clip(f, p, below);
-      for (const vec3& v : g)
-        if (std::fabs(p.distance(v)) <= 1e-6f * (1.0f + glm::length(v))) cut.push_back(v);
-      if (g.size() >= 3) out.faces_.push_back(std::move(g));
+    out.verts_.reserve(verts_.size() + 8);
+    thread_local std::vector<vec3> cut;
+    cut.clear();
+    const float sign = below ? 1.0f : -1.0f;
+    for (size_t k = 0; k < face_count(); ++k) {
+      const size_t first = out.verts_.size();
+      clip(k, sign, dist, out.verts_);
+      for (size_t i = first; i < out.verts_.size(); ++i)
+        if (std::fabs(p.distance(out.verts_[i])) <= 1e-6f * (1.0f + glm::length(out.verts_[i])))
+          cut.push_back(out.verts_[i]);
+      if (out.verts_.size() - first >= 3)
+        out.starts_.push_back(uint32_t(out.verts_.size()));
+      else
+        out.verts_.resize(first);
     }
-    if (cut.size() >= 3) out.faces_.push_back(order_cut(cut, below ? p.n : -p.n));
+    if (cut.size() >= 3) {
+      order_cut(cut, below ? p.n : -p.n, out.verts_);
+      out.starts_.push_back(uint32_t(out.verts_.size()));
+    }
+    for (const vec3& v : out.verts_) out.bounds_.extend(v);
     return out;
   }
 
- private:
   /// Running vector area of a polygon given vertex by vertex.
   struct VectorAreaSum {
     vec3 first{0.0f}, last{0.0f}, sum{0.0f};
@@ -131,28 +174,28 @@ class ConvexCell {
   };
 
   /// Half the sum of the edge cross products: normal times area.
-  static vec3 vector_area(const std::vector<vec3>& f) {
+  static vec3 vector_area(std::span<const vec3> f) {
     vec3 s(0.0f);
     for (size_t i = 0; i < f.size(); ++i) s += glm::cross(f[i], f[(i + 1) % f.size()]);
     return 0.5f * s;
   }
 
-  /// Sutherland-Hodgman against one plane, keeping the below (or above) side.
-  static std::vector<vec3> clip(const std::vector<vec3>& f, const BspPlane& p, bool below) {
-    std::vector<vec3> out;
-    const float sign = below ? 1.0f : -1.0f;
-    for (size_t i = 0; i < f.size(); ++i) {
-      const vec3& a = f[i];
-      const vec3& b = f[(i + 1) % f.size()];
-      const float da = sign * p.distance(a), db = sign * p.distance(b);
+  /// Sutherland-Hodgman of face k against one plane whose signed distances (times sign: keeping the
+  /// below side for sign 1, the above side for -1) are dist; appends the kept polygon to out.
+  void clip(size_t k, float sign, const std::vector<float>& dist, std::vector<vec3>& out) const {
+    const uint32_t b0 = starts_[k], m = starts_[k + 1] - b0;
+    for (uint32_t i = 0; i < m; ++i) {
+      const uint32_t j = i + 1 == m ? 0 : i + 1;
+      const vec3 &a = verts_[b0 + i], &b = verts_[b0 + j];
+      const float da = sign * dist[b0 + i], db = sign * dist[b0 + j];
       if (da <= 0.0f) out.push_back(a);
       if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) out.push_back(a + (da / (da - db)) * (b - a));
     }
-    return out;
   }
 
-  /// The cut face's vertices, without near-duplicates, in counter-clockwise order around outward normal n.
-  static std::vector<vec3> order_cut(std::vector<vec3> pts, const vec3& n) {
+  /// Appends the cut face's vertices pts, without near-duplicates, in counter-clockwise order around
+  /// outward normal n.
+  static void order_cut(std::vector<vec3>& pts, const vec3& n, std::vector<vec3>& out) {
     vec3 c(0.0f);
     for (const vec3& v : pts) c += v;
     c /= float(pts.size());
@@ -167,18 +210,24 @@ class ConvexCell {
       const float q = y / r;
       return x >= 0.0f ? (y >= 0.0f ? q : 4.0f + q) : 2.0f - q;
     };
-    std::sort(pts.begin(), pts.end(), [&](const vec3& a, const vec3& b) { return angle(a) < angle(b); });
-    std::vector<vec3> out;
-    for (const vec3& v : pts)
-      if (out.empty() || glm::length(v - out.back()) > 1e-7f * (1.0f + glm::length(v))) out.push_back(v);
-    while (out.size() > 1 &&
-           glm::length(out.front() - out.back()) <= 1e-7f * (1.0f + glm::length(out.back())))
+    thread_local std::vector<std::pair<float, uint32_t>> keys;  // each point's angle, computed once
+    keys.clear();
+    for (size_t i = 0; i < pts.size(); ++i) keys.emplace_back(angle(pts[i]), uint32_t(i));
+    std::sort(keys.begin(), keys.end());
+    const size_t first = out.size();
+    for (const auto& [key, i] : keys)
+      if (const vec3& v = pts[i];
+          out.size() == first || glm::length(v - out.back()) > 1e-7f * (1.0f + glm::length(v)))
+        out.push_back(v);
+    while (out.size() > first + 1 &&
+           glm::length(out[first] - out.back()) <= 1e-7f * (1.0f + glm::length(out.back())))
       out.pop_back();
-    return out;
   }
 
-  std::vector<std::vector<vec3>> faces_;
-  bool box_ = false;  ///< the faces are those of an axis-aligned box (from_box)
+  std::vector<vec3> verts_;          ///< every face's vertices, face after face
+  std::vector<uint32_t> starts_{0};  ///< face k is verts_[starts_[k], starts_[k + 1])
+  AABB bounds_;                      ///< bounds of verts_
+  bool box_ = false;                 ///< the faces are those of an axis-aligned box (from_box)
 };
 
 /// The areas of a box cell cut by axis planes, in closed form (the k-d tree's SAH areas): the same
@@ -231,7 +280,9 @@ class BoxSurface {
 /// of its vertices along n; a clipped face keeps its normal, so by the closed-surface identity the cut
 /// face's area is -sum(dot(n, N_i) a_i(d)) over the faces' unit normals N_i and areas below a_i(d). Each
 /// plane then costs a few flops per surface triangle instead of clipping the polyhedron (ConvexCell::areas
-/// gives the same areas up to rounding).
+/// gives the same areas up to rounding). The triangles are kept field by field (structure of arrays), so
+/// that a direction's heights are computed kLanes triangles at a time, and kept for the next call with the
+/// same direction (extent, then areas).
 class CellSurface {
  public:
   /// Fan-triangulates the faces of cell.
@@ -241,19 +292,25 @@ class CellSurface {
 
   /// Makes this the surface of cell, keeping the buffers (one per thread in the BSP build).
   void assign(const ConvexCell& cell) {
-    tris_.clear();
+    count_ = 0;
     total_ = 0.0f;
     tol_ = 0.0f;
-    for (const auto& f : cell.faces())
-      for (size_t i = 2; i < f.size(); ++i) {
-        const vec3 cr = glm::cross(f[i - 1] - f[0], f[i] - f[0]);
-        const float twice = glm::length(cr);
-        if (!(twice > 0.0f)) continue;
-        tris_.push_back({f[0], f[i - 1], f[i], 0.5f * twice, cr / twice});
-        total_ += 0.5f * twice;
-      }
-    for (const auto& f : cell.faces())
-      for (const vec3& v : f) tol_ = std::max(tol_, 1e-6f * (1.0f + glm::length(v)));
+    for (auto& f : in_) f.clear();
+    for (size_t k = 0; k < cell.face_count(); ++k) {
+      const std::span<const vec3> f = cell.face(k);
+      for (size_t i = 2; i < f.size(); ++i) add(f[0], f[i - 1], f[i]);
+    }
+    for (const vec3& v : cell.vertices()) tol_ = std::max(tol_, 1e-6f * (1.0f + glm::length(v)));
+    padded_ = (count_ + kLanes - 1) / kLanes * kLanes;
+    // Padding lanes: h0 = +inf and h2 = -inf (no part below any plane, and no effect on the extent),
+    // zero area.
+    heights_.assign(kFields * padded_, 0.0f);
+    for (size_t i = count_; i < padded_; ++i) {
+      heights_[i] = kInf;
+      heights_[2 * padded_ + i] = -kInf;
+    }
+    std::copy(in_[kArea].begin(), in_[kArea].end(), heights_.begin() + ptrdiff_t(5 * padded_));
+    prepared_ = false;
   }
 
   /// Surface area.
@@ -261,47 +318,22 @@ class CellSurface {
 
   /// The cell's extent [lo, hi] along direction n.
   void extent(const vec3& n, float& lo, float& hi) const {
-    lo = kInf;
-    hi = -kInf;
-    for (const Tri& t : tris_)
-      for (const vec3& v : {t.a, t.b, t.c}) {
-        lo = std::min(lo, glm::dot(n, v));
-        hi = std::max(hi, glm::dot(n, v));
-      }
+    prepare(n);
+    lo = lowest_;
+    hi = highest_;
   }
 
   /// Areas of the parts below and above each plane dot(n, x) = d[k] (each including the cut face); a
   /// plane within rounding of the cell's extent along n does not cut it (one part gets zero area).
   void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
+    prepare(n);
     float* cut = above;  // the cut face's area goes to above[] until the end
-    float lowest = kInf, highest = -kInf;
-    const size_t chunks = (tris_.size() + kLanes - 1) / kLanes;
-    heights_.assign(chunks * kFields * kLanes, 0.0f);  // padding: zero area, so it adds nothing
-    for (size_t i = 0; i < tris_.size(); ++i) {
-      const Tri& t = tris_[i];
-      float h[3] = {glm::dot(n, t.a), glm::dot(n, t.b), glm::dot(n, t.c)};
-      if (h[0] > h[1]) std::swap(h[0], h[1]);
-      if (h[1] > h[2]) std::swap(h[1], h[2]);
-      if (h[0] > h[1]) std::swap(h[0], h[1]);
-      lowest = std::min(lowest, h[0]);
-      highest = std::max(highest, h[2]);
-      const float fields[kFields] = {h[0],
-                                     h[1],
-                                     h[2],
-                                     1.0f / ((h[1] - h[0]) * (h[2] - h[0])),
-                                     1.0f / ((h[2] - h[0]) * (h[2] - h[1])),
-                                     t.area,
-                                     glm::dot(n, t.normal) * t.area};
-      float* chunk = &heights_[i / kLanes * kFields * kLanes + i % kLanes];
-      for (size_t f = 0; f < kFields; ++f) chunk[f * kLanes] = fields[f];
-    }
     for (size_t k = 0; k < d.size(); ++k) area_below(d[k], below[k], cut[k]);
     for (size_t k = 0; k < d.size(); ++k) {
-      if (!(d[k] >
-            lowest + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as ConvexCell::part)
+      if (!(d[k] > lowest_ + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as part)
         below[k] = 0.0f;
         above[k] = total_;
-      } else if (!(d[k] < highest - tol_)) {
+      } else if (!(d[k] < highest_ - tol_)) {
         below[k] = total_;
         above[k] = 0.0f;
       } else {
@@ -313,43 +345,106 @@ class CellSurface {
   }
 
  private:
-  struct Tri {
-    vec3 a, b, c;
-    float area;
-    vec3 normal;
-  };
+  /// The input fields, one array each: the three corners' coordinates, the area and the unit normal.
+  enum In { kAx, kAy, kAz, kBx, kBy, kBz, kCx, kCy, kCz, kArea, kNx, kNy, kNz, kInFields };
+
+  /// Appends triangle (a, b, c) unless it has no area.
+  void add(const vec3& a, const vec3& b, const vec3& c) {
+    const vec3 cr = glm::cross(b - a, c - a);
+    const float twice = glm::length(cr);
+    if (!(twice > 0.0f)) return;
+    const vec3 nrm = cr / twice;
+    const float v[kInFields] = {a.x, a.y, a.z,          b.x,   b.y,   b.z,  c.x,
+                                c.y, c.z, 0.5f * twice, nrm.x, nrm.y, nrm.z};
+    for (size_t f = 0; f < kInFields; ++f) in_[f].push_back(v[f]);
+    total_ += 0.5f * twice;
+    ++count_;
+  }
+
+  /// prepare's fields of the count triangles of in (field by field) along n, into out (padded each; the
+  /// area is there already, set by assign). Two loops, as one with every field is not vectorized.
+  static void heights(size_t count, size_t padded, const vec3& n,
+                      const std::array<std::vector<float>, kInFields>& in, float* __restrict out) {
+    float* __restrict h0 = out, * __restrict h1 = h0 + padded, * __restrict h2 = h1 + padded;
+    float* __restrict il = h2 + padded, * __restrict ih = il + padded, * __restrict weighted = ih + 2 * padded;
+    const float *ax = in[kAx].data(), *ay = in[kAy].data(), *az = in[kAz].data();
+    const float *bx = in[kBx].data(), *by = in[kBy].data(), *bz = in[kBz].data();
+    const float *cx = in[kCx].data(), *cy = in[kCy].data(), *cz = in[kCz].data();
+    const float x = n.x, y = n.y, z = n.z;
+    for (size_t i = 0; i < count; ++i) {  // vectorized: a vector of triangles at a time
+      const float ha = x * ax[i] + y * ay[i] + z * az[i];
+      const float hb = x * bx[i] + y * by[i] + z * bz[i];
+      const float hc = x * cx[i] + y * cy[i] + z * cz[i];
+      const float lo = std::min(ha, hb), hi = std::max(ha, hb);
+      const float top = std::max(hi, hc), m = std::min(hi, hc);
+      const float low = std::min(lo, m), mid = std::max(lo, m);
+      h0[i] = low;
+      h1[i] = mid;
+      h2[i] = top;
+      il[i] = 1.0f / ((mid - low) * (top - low));
+      ih[i] = 1.0f / ((top - low) * (top - mid));
+    }
+    const float *ar = in[kArea].data(), *nx = in[kNx].data(), *ny = in[kNy].data(), *nz = in[kNz].data();
+    for (size_t i = 0; i < count; ++i) weighted[i] = (x * nx[i] + y * ny[i] + z * nz[i]) * ar[i];
+  }
+
+  /// The heights of every triangle along n, sorted, with the reciprocals of the two quadratics'
+  /// denominators, the area and the area times dot(n, normal), field by field (heights_), and the
+  /// extent; nothing when they are those of n already.
+  void prepare(const vec3& n) const {
+    if (prepared_ && n == dir_) return;
+    prepared_ = true;
+    dir_ = n;
+    const size_t padded = padded_;
+    heights(count_, padded, n, in_, heights_.data());
+    const float *h0 = heights_.data(), *h2 = h0 + 2 * padded;
+    std::array<float, kLanes> lo, hi;
+    lo.fill(kInf);
+    hi.fill(-kInf);
+    for (size_t i = 0; i < padded; i += kLanes)
+      for (size_t l = 0; l < kLanes; ++l) {
+        lo[l] = std::min(lo[l], h0[i + l]);
+        hi[l] = std::max(hi[l], h2[i + l]);
+      }
+    lowest_ = *std::min_element(lo.begin(), lo.end());
+    highest_ = *std::max_element(hi.begin(), hi.end());
+  }
 
   /// Sums of the surface's area below d and of the cut face's share, over kLanes triangles at a time
-  /// (one accumulator per lane: the loop over the lanes is vectorized). The heights are kept by chunks of
-  /// kLanes triangles, field by field: h0, h1, h2 (sorted), the reciprocals of the two quadratics'
-  /// denominators, the area and the area times dot(n, normal).
+  /// (one accumulator per lane: the loop over the lanes is vectorized).
   void area_below(float d, float& below, float& cut) const {
     std::array<float, kLanes> b{}, c{};
-    for (size_t i = 0; i < heights_.size(); i += kFields * kLanes) {
-      const float *h0 = &heights_[i], *h1 = h0 + kLanes, *h2 = h1 + kLanes, *il = h2 + kLanes;
-      const float *ih = il + kLanes, *area = ih + kLanes, *weighted = area + kLanes;
+    const size_t padded = padded_;
+    const float *h0 = heights_.data(), *h1 = h0 + padded, *h2 = h1 + padded, *il = h2 + padded;
+    const float *ih = il + padded, *area = ih + padded, *weighted = area + padded;
+    for (size_t i = 0; i < padded; i += kLanes) {
       for (size_t l = 0; l < kLanes; ++l) {
         // The fraction of the triangle's area below d, without branches (the reciprocal of a zero
-        // denominator is only ever in a lane the selects discard).
-        const float lo = d - h0[l], hi = h2[l] - d;
-        float f = d < h1[l] ? lo * lo * il[l] : 1.0f - hi * hi * ih[l];
-        f = d > h0[l] ? f : 0.0f;
-        f = d < h2[l] ? f : (d > h0[l] ? 1.0f : 0.0f);
-        b[l] += area[l] * f;
-        c[l] += weighted[l] * f;
+        // denominator, and a padding lane's, is only ever in a lane the selects discard).
+        const float lo = d - h0[i + l], hi = h2[i + l] - d;
+        float f = d < h1[i + l] ? lo * lo * il[i + l] : 1.0f - hi * hi * ih[i + l];
+        f = d > h0[i + l] ? f : 0.0f;
+        f = d < h2[i + l] ? f : (d > h0[i + l] ? 1.0f : 0.0f);
+        b[l] += area[i + l] * f;
+        c[l] += weighted[i + l] * f;
       }
     }
-    below = 0.0f;
-    cut = 0.0f;
-    for (size_t l = 0; l < kLanes; ++l) {
-      below += b[l];
-      cut -= c[l];
-    }
+    for (size_t w = kLanes / 2; w > 0; w /= 2)  // pairwise: a few vector additions, not a chain of 32
+      for (size_t l = 0; l < w; ++l) {
+        b[l] += b[l + w];
+        c[l] += c[l + w];
+      }
+    below = b[0];
+    cut = -c[0];
   }
   static constexpr size_t kLanes = 16, kFields = 7;
 
-  std::vector<Tri> tris_;
-  mutable std::vector<float> heights_;  ///< areas()'s scratch (area_below), kept over the node's directions
+  std::array<std::vector<float>, kInFields> in_;  ///< the triangles, field by field
+  size_t count_ = 0, padded_ = 0;                 ///< triangles, and rounded up to kLanes
+  mutable std::vector<float> heights_;  ///< prepare's fields for dir_, field by field (padded_ each)
+  mutable vec3 dir_{0.0f};
+  mutable bool prepared_ = false;
+  mutable float lowest_ = kInf, highest_ = -kInf;  ///< the extent along dir_
   float total_ = 0.0f;
   float tol_ = 0.0f;  ///< rounding band of a vertex's distance from a plane (as ConvexCell::part)
 };
