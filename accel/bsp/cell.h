@@ -119,14 +119,14 @@ class ConvexCell {
       neg |= dist[i] < -tol[i];
     }
     std::pair<ConvexCell, ConvexCell> out;
-    if (which & kBelow) out.first = side(p, true, neg, pos, dist);
-    if (which & kAbove) out.second = side(p, false, pos, neg, dist);
+    if (which & kBelow) out.first = side(p, true, neg, pos, dist, tol);
+    if (which & kAbove) out.second = side(p, false, pos, neg, dist, tol);
     return out;
   }
 
   /// The part on one side: `keeps` (some vertex clearly on that side), `removes` (some on the other).
-  ConvexCell side(const BspPlane& p, bool below, bool keeps, bool removes,
-                  const std::vector<float>& dist) const {
+  ConvexCell side(const BspPlane& p, bool below, bool keeps, bool removes, const std::vector<float>& dist,
+                  const std::vector<float>& tol) const {
     if (!keeps) return ConvexCell{};
     if (!removes) return *this;
     if (const int a = exact_axis(p); box_ && a >= 0) {
@@ -142,10 +142,7 @@ class ConvexCell {
     const float sign = below ? 1.0f : -1.0f;
     for (size_t k = 0; k < face_count(); ++k) {
       const size_t first = out.verts_.size();
-      clip(k, sign, dist, out.verts_);
-      for (size_t i = first; i < out.verts_.size(); ++i)
-        if (std::fabs(p.distance(out.verts_[i])) <= 1e-6f * (1.0f + glm::length(out.verts_[i])))
-          cut.push_back(out.verts_[i]);
+      clip(k, p, sign, dist, tol, out.verts_, cut);
       if (out.verts_.size() - first >= 3)
         out.starts_.push_back(uint32_t(out.verts_.size()));
       else
@@ -180,16 +177,25 @@ class ConvexCell {
     return 0.5f * s;
   }
 
-  /// Sutherland-Hodgman of face k against one plane whose signed distances (times sign: keeping the
-  /// below side for sign 1, the above side for -1) are dist; appends the kept polygon to out.
-  void clip(size_t k, float sign, const std::vector<float>& dist, std::vector<vec3>& out) const {
+  /// Sutherland-Hodgman of face k against plane p, whose signed distances (times sign: keeping the below
+  /// side for sign 1, the above side for -1) are dist, with each vertex's rounding band tol; appends the
+  /// kept polygon to out, and its points within rounding of the plane to cut.
+  void clip(size_t k, const BspPlane& p, float sign, const std::vector<float>& dist,
+            const std::vector<float>& tol, std::vector<vec3>& out, std::vector<vec3>& cut) const {
     const uint32_t b0 = starts_[k], m = starts_[k + 1] - b0;
     for (uint32_t i = 0; i < m; ++i) {
       const uint32_t j = i + 1 == m ? 0 : i + 1;
       const vec3 &a = verts_[b0 + i], &b = verts_[b0 + j];
       const float da = sign * dist[b0 + i], db = sign * dist[b0 + j];
-      if (da <= 0.0f) out.push_back(a);
-      if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) out.push_back(a + (da / (da - db)) * (b - a));
+      if (da <= 0.0f) {
+        out.push_back(a);
+        if (std::fabs(dist[b0 + i]) <= tol[b0 + i]) cut.push_back(a);
+      }
+      if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) {
+        const vec3 x = a + (da / (da - db)) * (b - a);
+        out.push_back(x);
+        if (std::fabs(p.distance(x)) <= 1e-6f * (1.0f + glm::length(x))) cut.push_back(x);
+      }
     }
   }
 
