@@ -253,6 +253,27 @@ class BspBuilder {
     }
   }
 
+  /// The signed-distance ranges [lo[k], hi[k]] of every primitive's support points from the plane through
+  /// the origin with normal n: every point's distance in one loop (vectorized), then each primitive's
+  /// extremes (range's values: the extremes of the distances, less d, are the extremes less d).
+  static void ranges(const NodePrims& np, const vec3& n, std::vector<float>& dots, float* lo, float* hi) {
+    const size_t m = np.pts.size();
+    dots.resize(m);
+    const vec3* __restrict p = np.pts.data();
+    float* __restrict out = dots.data();
+    const float x = n.x, y = n.y, z = n.z;
+    for (size_t j = 0; j < m; ++j) out[j] = x * p[j].x + y * p[j].y + z * p[j].z;
+    for (size_t k = 0; k < np.size(); ++k) {
+      float a = kInf, b = -kInf;
+      for (uint32_t j = np.start[k]; j < np.start[k + 1]; ++j) {
+        a = std::min(a, out[j]);
+        b = std::max(b, out[j]);
+      }
+      lo[k] = a;
+      hi[k] = b;
+    }
+  }
+
   /// The cell's surface area and its reciprocal.
   struct CellArea {
     float area, inv;
@@ -310,6 +331,13 @@ class BspBuilder {
     if (nl < n && nr < n && c < ch.progress.cost) ch.progress = {plane, c};
   }
 
+  /// The buffers of binned_planes, kept over the 13 directions of a node.
+  struct PlaneScratch {
+    std::vector<float> lo, hi, d, al, ar;
+    std::vector<uint32_t> nl, nr, starts, ends;
+    std::vector<float> dots;  ///< every support point's distance (ranges)
+  };
+
   /// The node's best planes over its candidates (binned_planes per direction, autopartition_planes);
   /// `large`: the three axes only.
   Choices find_plane(const NodePrims& np, const ConvexCell& cell, bool shave_ok, bool large) const {
@@ -342,7 +370,7 @@ class BspBuilder {
     const auto& dirs = bsp_directions();
     for (size_t i = 0; i < (large ? 3 : dirs.size()); ++i)
       binned_planes(np, surface, cell_area, dirs[i], shave_ok, scratch, ch);
-    if (!large) autopartition_planes(np, surface, cell_area, shave_ok, ch);
+    if (!large) autopartition_planes(np, surface, cell_area, shave_ok, scratch, ch);
     return ch;
   }
 
@@ -351,8 +379,10 @@ class BspBuilder {
 
   /// The supporting planes of up to `autopartition` of the node's triangles (Ize, Wald and Parker 2008).
   void autopartition_planes(const NodePrims& np, const CellSurface& surface, const CellArea& cell_area,
-                            bool shave_ok, Choices& ch) const {
+                            bool shave_ok, PlaneScratch& scratch, Choices& ch) const {
     const size_t k = std::min<size_t>(np.size(), size_t(config_.autopartition));
+    scratch.lo.resize(np.size());
+    scratch.hi.resize(np.size());
     for (size_t j = 0; j < k; ++j) {
       BspPlane own;
       if (!supporting_plane(prims_, np.ids[j * np.size() / k], own)) continue;
@@ -362,9 +392,9 @@ class BspBuilder {
       float al[3], ar[3];
       surface.areas(own.n, d, al, ar);
       size_t nl[3] = {0, 0, 0}, nr[3] = {0, 0, 0};
+      ranges(np, own.n, scratch.dots, scratch.lo.data(), scratch.hi.data());
       for (size_t i = 0; i < np.size(); ++i) {
-        float lo, hi;  // one range for the three planes, shifted
-        range(np, i, own.n, own.d, lo, hi);
+        const float lo = scratch.lo[i] - own.d, hi = scratch.hi[i] - own.d;  // for the three planes, shifted
         for (int m = 0; m < 3; ++m) {
           const int s = side_bits(lo - (d[m] - own.d), hi - (d[m] - own.d));
           nl[m] += s & 1;
@@ -375,12 +405,6 @@ class BspBuilder {
         keep(ch, BspPlane{own.n, d[m]}, cell_area, al[m], ar[m], nl[m], nr[m], np.size(), shave_ok);
     }
   }
-
-  /// The buffers of binned_planes, kept over the 13 directions of a node.
-  struct PlaneScratch {
-    std::vector<float> lo, hi, d, al, ar;
-    std::vector<uint32_t> nl, nr, starts, ends;
-  };
 
   /// Candidate planes of direction dir. A node of at most `bins` primitives tries the planes at the ends of
   /// each primitive's extent (the primitive is classified on one side only), like the events of a k-d sweep;
@@ -400,8 +424,8 @@ class BspBuilder {
     nl.clear();
     nr.clear();
     float range_lo = kInf, range_hi = -kInf;
+    ranges(np, dir, s.dots, lo.data(), hi.data());
     for (size_t i = 0; i < n; ++i) {
-      range(np, i, dir, 0.0f, lo[i], hi[i]);
       range_lo = std::min(range_lo, lo[i]);
       range_hi = std::max(range_hi, hi[i]);
     }

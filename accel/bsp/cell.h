@@ -435,15 +435,21 @@ class CellSurface {
         c[l] += weighted[i + l] * f;
       }
     }
-    for (size_t w = kLanes / 2; w > 0; w /= 2)  // pairwise: a few vector additions, not a chain of 32
-      for (size_t l = 0; l < w; ++l) {
-        b[l] += b[l + w];
-        c[l] += c[l + w];
-      }
+    fold<kLanes / 2>(b, c);  // pairwise: a few vector additions, not a chain of 32
     below = b[0];
     cut = -c[0];
   }
   static constexpr size_t kLanes = 16, kFields = 7;
+  /// Adds the upper W lanes of b and c to the lower ones, down to one lane (fixed widths, so each step is
+  /// one vector addition).
+  template <size_t W>
+  static void fold(std::array<float, kLanes>& b, std::array<float, kLanes>& c) {
+    for (size_t l = 0; l < W; ++l) {
+      b[l] += b[l + W];
+      c[l] += c[l + W];
+    }
+    if constexpr (W > 1) fold<W / 2>(b, c);
+  }
 
   std::array<std::vector<float>, kInFields> in_;  ///< the triangles, field by field
   size_t count_ = 0, padded_ = 0;                 ///< triangles, and rounded up to kLanes
