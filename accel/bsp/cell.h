@@ -334,7 +334,18 @@ class CellSurface {
   void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
     prepare(n);
     float* cut = above;  // the cut face's area goes to above[] until the end
-    for (size_t k = 0; k < d.size(); ++k) area_below(d[k], below[k], cut[k]);
+    lanes_.resize(2 * kLanes * d.size());
+    for (size_t k = 0; k < d.size(); ++k) area_below(d[k], &lanes_[2 * kLanes * k]);
+    for (size_t k = 0; k < d.size(); ++k) {  // the planes' lane sums are independent: they overlap
+      const float* l = &lanes_[2 * kLanes * k];
+      float sb = 0.0f, sc = 0.0f;
+      for (size_t j = 0; j < kLanes; ++j) {
+        sb += l[j];
+        sc -= l[kLanes + j];
+      }
+      below[k] = sb;
+      cut[k] = sc;
+    }
     for (size_t k = 0; k < d.size(); ++k) {
       if (!(d[k] > lowest_ + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as part)
         below[k] = 0.0f;
@@ -416,9 +427,9 @@ class CellSurface {
     highest_ = *std::max_element(hi.begin(), hi.end());
   }
 
-  /// Sums of the surface's area below d and of the cut face's share, over kLanes triangles at a time
-  /// (one accumulator per lane: the loop over the lanes is vectorized).
-  void area_below(float d, float& below, float& cut) const {
+  /// The per-lane sums of the surface's area below d and of the cut face's share (kLanes each, into out),
+  /// over kLanes triangles at a time (one accumulator per lane: the loop over the lanes is vectorized).
+  void area_below(float d, float* __restrict out) const {
     std::array<float, kLanes> b{}, c{};
     const size_t padded = padded_;
     const float *h0 = heights_.data(), *h1 = h0 + padded, *h2 = h1 + padded, *il = h2 + padded;
@@ -435,24 +446,14 @@ class CellSurface {
         c[l] += weighted[i + l] * f;
       }
     }
-    fold<kLanes / 2>(b, c);  // pairwise: a few vector additions, not a chain of 32
-    below = b[0];
-    cut = -c[0];
+    std::copy(b.begin(), b.end(), out);
+    std::copy(c.begin(), c.end(), out + kLanes);
   }
   static constexpr size_t kLanes = 16, kFields = 7;
-  /// Adds the upper W lanes of b and c to the lower ones, down to one lane (fixed widths, so each step is
-  /// one vector addition).
-  template <size_t W>
-  static void fold(std::array<float, kLanes>& b, std::array<float, kLanes>& c) {
-    for (size_t l = 0; l < W; ++l) {
-      b[l] += b[l + W];
-      c[l] += c[l + W];
-    }
-    if constexpr (W > 1) fold<W / 2>(b, c);
-  }
 
   std::array<std::vector<float>, kInFields> in_;  ///< the triangles, field by field
   size_t count_ = 0, padded_ = 0;                 ///< triangles, and rounded up to kLanes
+  mutable std::vector<float> lanes_;              ///< areas()'s per-plane lane sums (area_below), kLanes each
   mutable std::vector<float> heights_;  ///< prepare's fields for dir_, field by field (padded_ each)
   mutable vec3 dir_{0.0f};
   mutable bool prepared_ = false;
