@@ -146,6 +146,33 @@ TEST(BvhBuild, SameTreeForAnyThreadCountWithParallelPathsForced) {
   expect_same_tree_for_any_thread_count<BvhMedianConfig>(in, "bvh-median");
 }
 
+/// The flattened layout (slots.h): root at 0, padding at 1, and the children of the k-th interior node of a
+/// depth-first walk (left child first) at pair 2 + 2k, with nothing after the last pair.
+void expect_depth_first_pairs(const BvhBuildResult& r, const char* name) {
+  ASSERT_GE(r.nodes.size(), 2u) << name;
+  EXPECT_EQ(r.nodes[1].count, 1u) << name;  // the padding node
+  uint32_t next_pair = 2;
+  std::vector<uint32_t> stack{0};
+  while (!stack.empty()) {
+    const BvhNode& n = r.nodes[stack.back()];
+    stack.pop_back();
+    if (n.is_leaf()) continue;
+    ASSERT_EQ(n.offset, next_pair) << name;
+    next_pair += 2;
+    stack.push_back(n.offset + 1);
+    stack.push_back(n.offset);
+  }
+  EXPECT_EQ(r.nodes.size(), next_pair) << name;
+}
+
+TEST(BvhBuild, FlattenedInDepthFirstPairOrder) {
+  // Above the flattening's parallel subtrees (2^15 slots), with leaves of several primitives.
+  const Inputs in = inputs_of(random_soup(70000, 22, 0.01f));
+  expect_depth_first_pairs(build_with<BvhSahConfig>(in, 2), "bvh-sah");
+  expect_depth_first_pairs(build_with<BvhSweepConfig>(in, 2), "bvh-sweep");
+  expect_depth_first_pairs(build_with<BvhMedianConfig>(in, 2), "bvh-median");
+}
+
 TEST(BvhBuild, BinnedChildBoxesAreTightAndLeavesAPermutation) {
   const Mesh mesh = random_soup(5000, 8, 0.05f);
   const Inputs in = inputs_of(mesh);
