@@ -185,6 +185,39 @@ TEST(Bsp, TheBudgetedAttemptTakesTheFirstAttemptsDecisions) {
   EXPECT_EQ(count_differences("bsp", mesh, rays, {{"ref_budget", "4"}}), 0u);
 }
 
+TEST(Bsp, TheBreadthFirstTopGivesTheDepthFirstTree) {
+  // The first attempt builds its top levels breadth first and the rest depth first (build_top, with
+  // reuse_decisions on); off, the whole tree is built depth first. Trees within the budget: the same tree
+  // (a small one the top finishes alone, a larger one it hands on at 1024 nodes a level), at 1 and 2 threads.
+  for (const auto& [generator, triangles] : {std::pair{"sphereflake", 4000}, std::pair{"terrain", 300}}) {
+    const Mesh mesh = generate_mesh(generator, triangles, 5, Params());
+    auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
+    const std::vector<Ray> rays = adversarial_rays(mesh, 1000, 15);
+    auto build = [&](bool top, int threads, std::vector<Hit>& hits) {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, size_t(threads));
+      BspConfig config;
+      config.reuse_decisions = top;
+      BspTree<TrianglePrims> tree(prims, config);
+      tree.build();
+      hits.resize(rays.size());
+      tree.intersect(rays, hits);
+      return tree.stats();
+    };
+    std::vector<Hit> without, with1, with2;
+    const BuildStats base = build(false, 1, without);
+    EXPECT_EQ(base.extra.at("budget_exhausted"), false) << generator;
+    for (auto* hits : {&with1, &with2}) {
+      const BuildStats s = build(true, hits == &with1 ? 1 : 2, *hits);
+      EXPECT_EQ(s.nodes, base.nodes) << generator;
+      EXPECT_EQ(s.references, base.references) << generator;
+      EXPECT_EQ(s.max_depth, base.max_depth) << generator;
+      EXPECT_EQ(s.leaf_size_histogram, base.leaf_size_histogram) << generator;
+      EXPECT_EQ(s.extra.at("oblique_planes"), base.extra.at("oblique_planes")) << generator;
+      EXPECT_EQ(0, std::memcmp(hits->data(), without.data(), without.size() * sizeof(Hit))) << generator;
+    }
+  }
+}
+
 TEST(Bsp, SplitsThatShrinkAFansCentreAreNoShaves) {
   // Every triangle of a fan meets its centre, so every plane keeps nearly all of them on the centre's
   // side: as shaves they stop after bad_refines, leaving a large leaf at the centre; splits that shrink

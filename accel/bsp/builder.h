@@ -10,10 +10,12 @@
 // any thread count).
 #pragma once
 
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <span>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -48,7 +50,10 @@ class BspBuilder {
       out = BspBuffer{};
       NodePrims root = gather_root(ids, box);
       count_frontier_root(ledger, root.size());
-      build_node(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, 0, out);
+      if (ledger && config_.reuse_decisions)
+        build_top(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, out);
+      else
+        build_node(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, 0, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;
@@ -200,46 +205,173 @@ class BspBuilder {
   /// Appends a leaf of the node's primitives.
   void make_leaf(const NodePrims& np, BspBuffer& out) const { out.nodes.push_back(out.make_leaf(np.ids)); }
 
+  /// A node's decision carried out on its primitives: the plane's sides of each primitive and the counts,
+  /// or a leaf (no plane, an empty or undivided split, or one the budget does not allow).
+  struct Step {
+    Decision d;
+    std::vector<uint8_t> sides;
+    size_t nl = 0, nr = 0;
+    bool leaf = true;
+  };
+  /// The node's step; a split is counted in the first attempt's ledger.
+  Step step(const NodePrims& np, const ConvexCell& cell, const Depth& depth, uint32_t at) const {
+    const size_t n = np.size();
+    Step s;
+    s.d = memoized_decision(np, cell, depth, at);
+    if (s.d.split) classify(np, s.d.plane, s.sides, s.nl, s.nr);
+    const size_t nl = s.nl, nr = s.nr;
+    s.leaf = (nl == 0 && nr == 0) || (nl == n && nr == n) || (s.d.forced && std::max(nl, nr) == n) ||
+             !depth.budget.allows(nl + nr);
+    if (!s.leaf) count_frontier_split(ledger_, n, nl, nr);
+    return s;
+  }
+
+  /// The two children of a node that splits (step): their primitives, cells and depths.
+  struct Children {
+    NodePrims prims[2];
+    ConvexCell cells[2];
+    Depth depths[2];
+  };
+  Children children(const NodePrims& np, const ConvexCell& cell, const Depth& depth, const Step& s) const {
+    const size_t n = np.size(), nl = s.nl, nr = s.nr;
+    Children c;
+    std::tie(c.cells[0], c.cells[1]) = cell.parts(s.d.plane);
+    c.prims[0] = child_prims(np, s.sides, 1, s.d.plane, c.cells[0]);
+    c.prims[1] = child_prims(np, s.sides, 2, s.d.plane, c.cells[1]);
+    const bool shave = is_shave(nl, nr, n, !s.d.forced,
+                                [&] { return (nl >= nr ? c.cells[0] : c.cells[1]).area() / cell.area(); });
+    const int levels = depth.levels + 1, splits = depth.splits + int(nl > 0 && nr > 0);
+    const int shaves = depth.shaves + int(shave);
+    c.depths[0] = Depth{levels, splits, shaves, depth.budget.share(nl, nl + nr)};
+    c.depths[1] = Depth{levels, splits, shaves, depth.budget.share(nr, nl + nr)};
+    return c;
+  }
+
   /// Builds the node of primitives np in cell into out; `at`: its node in the memo (memoized_decision).
   void build_node(NodePrims&& np, const ConvexCell& cell, Depth depth, uint32_t at, BspBuffer& out) const {
     if (ledger_ && ledger_->over()) return out.nodes.push_back(kAbandoned);
+    const Step s = step(np, cell, depth, at);
+    if (s.leaf) return make_leaf(np, out);
+    grow(std::move(np), cell, depth, at, s, out);
+  }
+
+  /// Builds the subtrees of a node that splits (step s) into out, after the node itself.
+  void grow(NodePrims&& np, const ConvexCell& cell, const Depth& depth, uint32_t at, const Step& s,
+            BspBuffer& out) const {
     const size_t n = np.size();
-    const Decision d = memoized_decision(np, cell, depth, at);
-    std::vector<uint8_t> sides;
-    size_t nl = 0, nr = 0;
-    if (d.split) classify(np, d.plane, sides, nl, nr);
-    if ((nl == 0 && nr == 0) || (nl == n && nr == n) || (d.forced && std::max(nl, nr) == n) ||
-        !depth.budget.allows(nl + nr)) {
-      return make_leaf(np, out);
-    }
-    count_frontier_split(ledger_, n, nl, nr);
-    const auto [lcell, rcell] = cell.parts(d.plane);
-    NodePrims left = child_prims(np, sides, 1, d.plane, lcell);
-    NodePrims right = child_prims(np, sides, 2, d.plane, rcell);
+    Children c = children(np, cell, depth, s);
     np = NodePrims{};
-    const bool shave =
-        is_shave(nl, nr, n, !d.forced, [&] { return (nl >= nr ? lcell : rcell).area() / cell.area(); });
-    const int levels = depth.levels + 1, splits = depth.splits + int(nl > 0 && nr > 0);
-    const int shaves = depth.shaves + int(shave);
-    const Depth lnext{levels, splits, shaves, depth.budget.share(nl, nl + nr)};
-    const Depth rnext{levels, splits, shaves, depth.budget.share(nr, nl + nr)};
     const size_t self = out.nodes.size();
     const uint32_t plane = uint32_t(out.payload.size());
-    out.payload.push_back(d.plane);
+    out.payload.push_back(s.d.plane);
     out.nodes.push_back(BspNode::leaf(0, 0));
     const uint32_t lat = memo_child(at, 0), rat = memo_child(at, 1);
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(left), lcell, lnext, lat, lb); },
-                           [&] { build_node(std::move(right), rcell, rnext, rat, rb); });
+      tbb::parallel_invoke([&] { build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, lb); },
+                           [&] { build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, rb); });
       out.append(lb);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
       out.append(rb);
     } else {
-      build_node(std::move(left), lcell, lnext, lat, out);
+      build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, out);
       out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(right), rcell, rnext, rat, out);
+      build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, out);
     }
+  }
+
+  /// A node of the first attempt's breadth-first top (build_top).
+  struct TopNode {
+    NodePrims np;
+    ConvexCell cell;
+    Depth depth;
+    BspPlane plane;
+    uint32_t below = 0, above = 0;  ///< the children, when split
+    bool split = false;
+    BspBuffer sub;  ///< a leaf's node, or the subtree of a node the top left to the depth-first build
+  };
+
+  /// The first attempt's top levels built breadth first, each level's nodes in parallel, until a level
+  /// holds more than min(ref_budget x N, kTopRefs) references or too many nodes (kTopNodes); then the nodes
+  /// left are built depth first (build_node), each into its own buffer, in parallel, and everything is laid
+  /// out as build_node would have written it (the same decisions, so the same tree). A tree over the budget
+  /// passes it as its frontier (ref_frontier.h) does, and breadth first that is after its first few
+  /// duplicating levels (large overlapping triangles: every split copies most of them): depth first, the
+  /// first subtree alone was built to its leaves before the others' copies were counted (20k `large`: 362,805
+  /// nodes made before the abandon, against 40,481 in the budgeted tree).
+  void build_top(NodePrims&& root, const ConvexCell& cell, const Depth& depth, BspBuffer& out) const {
+    std::vector<TopNode> t(1);
+    t[0].np = std::move(root);
+    t[0].cell = cell;
+    t[0].depth = depth;
+    const double limit = std::min(config_.ref_budget * double(t[0].np.size()), double(kTopRefs));
+    std::vector<uint32_t> level{0};
+    size_t previous = 0;  // the references of the level before
+    while (!level.empty() && !ledger_->over()) {
+      size_t refs = 0;
+      for (uint32_t i : level) refs += t[i].np.size();
+      const bool duplicating = double(refs) > kTopGrowth * double(previous);
+      if (double(refs) > limit || level.size() > kTopNodesMax || (level.size() > kTopNodes && !duplicating))
+        break;
+      previous = refs;
+      std::vector<Step> steps(level.size());
+      tbb::parallel_for(size_t(0), level.size(), [&](size_t k) {
+        const TopNode& x = t[level[k]];
+        steps[k] = step(x.np, x.cell, x.depth, kNoMemo);
+      });
+      if (ledger_->over()) break;
+      level = top_children(t, level, steps);
+    }
+    tbb::parallel_for(size_t(0), level.size(), [&](size_t k) {
+      TopNode& x = t[level[k]];
+      build_node(std::move(x.np), x.cell, x.depth, kNoMemo, x.sub);
+    });
+    lay_out(t, 0, out);
+  }
+
+  /// The next level of build_top: the children of the level's nodes that split (in parallel, appended in
+  /// the level's order); the leaves made.
+  std::vector<uint32_t> top_children(std::vector<TopNode>& t, const std::vector<uint32_t>& level,
+                                     const std::vector<Step>& steps) const {
+    std::vector<Children> kids(level.size());
+    tbb::parallel_for(size_t(0), level.size(), [&](size_t k) {
+      TopNode& x = t[level[k]];
+      if (steps[k].leaf)
+        make_leaf(x.np, x.sub);
+      else
+        kids[k] = children(x.np, x.cell, x.depth, steps[k]);
+    });
+    std::vector<uint32_t> next;
+    for (size_t k = 0; k < level.size(); ++k) {
+      const uint32_t i = level[k];
+      t[i].np = NodePrims{};
+      t[i].cell = ConvexCell{};
+      if (steps[k].leaf) continue;
+      t[i].split = true;
+      t[i].plane = steps[k].d.plane;
+      for (int side = 0; side < 2; ++side) {
+        (side ? t[i].above : t[i].below) = uint32_t(t.size());
+        next.push_back(uint32_t(t.size()));
+        TopNode child;
+        child.np = std::move(kids[k].prims[side]);
+        child.cell = std::move(kids[k].cells[side]);
+        child.depth = kids[k].depths[side];
+        t.push_back(std::move(child));
+      }
+    }
+    return next;
+  }
+
+  /// Writes build_top's node i and its subtree into out in build_node's order.
+  static void lay_out(const std::vector<TopNode>& t, uint32_t i, BspBuffer& out) {
+    if (!t[i].split) return out.append(t[i].sub);
+    const size_t self = out.nodes.size();
+    const uint32_t plane = uint32_t(out.payload.size());
+    out.payload.push_back(t[i].plane);
+    out.nodes.push_back(BspNode::leaf(0, 0));
+    lay_out(t, t[i].below, out);
+    out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
+    lay_out(t, t[i].above, out);
   }
 
   /// Signed-distance range of primitive k's support points from plane (dir, d).
@@ -540,6 +672,15 @@ class BspBuilder {
   static constexpr size_t kKeptScratchMax = 4096;
   /// Nodes at least this large build their children in parallel (BSP nodes are costly: split the work deep).
   static constexpr size_t kParallelMin = 256;
+  /// build_top's levels hold at most this many references (about 300 MB of clipped parts), so a 10M input's
+  /// root goes straight to the depth-first build; at least half of the 200k hostile inputs' budget.
+  static constexpr size_t kTopRefs = size_t(1) << 22;
+  /// build_top's levels hold at most kTopNodes nodes, or kTopNodesMax while each level holds more than
+  /// kTopGrowth times the references of the one before: a tree over the budget passes it within its first
+  /// duplicating levels, and any other tree goes on depth first, with little memory (the same tree either
+  /// way: these bounds only choose the order of the work).
+  static constexpr size_t kTopNodes = 1024, kTopNodesMax = 16384;
+  static constexpr double kTopGrowth = 1.25;
   const P& prims_;
   BspConfig config_;
   int depth_limit_;                      ///< resolved depth limit (> 0)
