@@ -151,17 +151,12 @@ TEST(BspCell, ABoxCutByAxisPlanesStaysABoxWithTheCellSurfacesAreas) {
   }
 }
 
-TEST(Bsp, TheBudgetedAttemptTakesTheFirstAttemptsDecisions) {
-  // Large overlapping triangles pass a budget of 4 references per triangle: the second attempt takes the
-  // first one's decisions (reuse_decisions), which must give the tree it makes without them, at any
-  // thread count (the first attempt reaches other nodes before it is abandoned).
-  const Mesh mesh = generate_mesh("large", 1500, 3, Params());
+/// Builds the bsp over mesh with config and reuse_decisions off (1 thread), then on (1 and 2 threads), and
+/// expects the same tree and hits each time; returns the first build's statistics.
+BuildStats expect_reuse_keeps_the_tree(const Mesh& mesh, BspConfig config, const std::vector<Ray>& rays) {
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
-  const std::vector<Ray> rays = adversarial_rays(mesh, 1500, 14);
   auto build = [&](bool reuse, int threads, std::vector<Hit>& hits) {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    BspConfig config;
-    config.ref_budget = 4.0;
     config.reuse_decisions = reuse;
     BspTree<TrianglePrims> tree(prims, config);
     tree.build();
@@ -171,8 +166,6 @@ TEST(Bsp, TheBudgetedAttemptTakesTheFirstAttemptsDecisions) {
   };
   std::vector<Hit> without, with1, with2;
   const BuildStats base = build(false, 1, without);
-  EXPECT_EQ(base.extra.at("budget_exhausted"), true);
-  EXPECT_LE(base.references, 4 * base.primitives);
   for (auto* hits : {&with1, &with2}) {
     const BuildStats s = build(true, hits == &with1 ? 1 : 2, *hits);
     EXPECT_EQ(s.nodes, base.nodes);
@@ -182,7 +175,20 @@ TEST(Bsp, TheBudgetedAttemptTakesTheFirstAttemptsDecisions) {
     EXPECT_EQ(s.extra.at("oblique_planes"), base.extra.at("oblique_planes"));
     EXPECT_EQ(0, std::memcmp(hits->data(), without.data(), without.size() * sizeof(Hit)));
   }
-  EXPECT_EQ(count_differences("bsp", mesh, rays, {{"ref_budget", "4"}}), 0u);
+  return base;
+}
+
+TEST(Bsp, TheBudgetedAttemptTakesTheFirstAttemptsDecisions) {
+  // Large overlapping triangles pass a budget of 4 references per triangle: the second attempt takes the
+  // first one's decisions (reuse_decisions), which must give the tree it makes without them, at any
+  // thread count (the first attempt reaches other nodes before it is abandoned).
+  const Mesh mesh = generate_mesh("large", 1500, 3, Params());
+  BspConfig config;
+  config.ref_budget = 4.0;
+  const BuildStats base = expect_reuse_keeps_the_tree(mesh, config, adversarial_rays(mesh, 1500, 14));
+  EXPECT_EQ(base.extra.at("budget_exhausted"), true);
+  EXPECT_LE(base.references, 4 * base.primitives);
+  EXPECT_EQ(count_differences("bsp", mesh, adversarial_rays(mesh, 1500, 14), {{"ref_budget", "4"}}), 0u);
 }
 
 TEST(Bsp, TheBreadthFirstTopGivesTheDepthFirstTree) {
@@ -190,31 +196,10 @@ TEST(Bsp, TheBreadthFirstTopGivesTheDepthFirstTree) {
   // reuse_decisions on); off, the whole tree is built depth first. Trees within the budget: the same tree
   // (a small one the top finishes alone, a larger one it hands on at 1024 nodes a level), at 1 and 2 threads.
   for (const auto& [generator, triangles] : {std::pair{"sphereflake", 4000}, std::pair{"terrain", 300}}) {
+    SCOPED_TRACE(generator);
     const Mesh mesh = generate_mesh(generator, triangles, 5, Params());
-    auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(mesh));
-    const std::vector<Ray> rays = adversarial_rays(mesh, 1000, 15);
-    auto build = [&](bool top, int threads, std::vector<Hit>& hits) {
-      tbb::global_control c(tbb::global_control::max_allowed_parallelism, size_t(threads));
-      BspConfig config;
-      config.reuse_decisions = top;
-      BspTree<TrianglePrims> tree(prims, config);
-      tree.build();
-      hits.resize(rays.size());
-      tree.intersect(rays, hits);
-      return tree.stats();
-    };
-    std::vector<Hit> without, with1, with2;
-    const BuildStats base = build(false, 1, without);
-    EXPECT_EQ(base.extra.at("budget_exhausted"), false) << generator;
-    for (auto* hits : {&with1, &with2}) {
-      const BuildStats s = build(true, hits == &with1 ? 1 : 2, *hits);
-      EXPECT_EQ(s.nodes, base.nodes) << generator;
-      EXPECT_EQ(s.references, base.references) << generator;
-      EXPECT_EQ(s.max_depth, base.max_depth) << generator;
-      EXPECT_EQ(s.leaf_size_histogram, base.leaf_size_histogram) << generator;
-      EXPECT_EQ(s.extra.at("oblique_planes"), base.extra.at("oblique_planes")) << generator;
-      EXPECT_EQ(0, std::memcmp(hits->data(), without.data(), without.size() * sizeof(Hit))) << generator;
-    }
+    const BuildStats base = expect_reuse_keeps_the_tree(mesh, BspConfig{}, adversarial_rays(mesh, 1000, 15));
+    EXPECT_EQ(base.extra.at("budget_exhausted"), false);
   }
 }
 
