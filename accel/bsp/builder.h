@@ -261,23 +261,32 @@ class BspBuilder {
     const size_t n = np.size();
     Children c = children(np, cell, depth, s);
     np = NodePrims{};
-    const size_t self = out.nodes.size();
-    const uint32_t plane = uint32_t(out.payload.size());
-    out.payload.push_back(s.d.plane);
-    out.nodes.push_back(BspNode::leaf(0, 0));
     const uint32_t lat = memo_child(at, 0), rat = memo_child(at, 1);
     if (n >= kParallelMin) {
       BspBuffer lb, rb;
       tbb::parallel_invoke([&] { build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, lb); },
                            [&] { build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, rb); });
-      out.append(lb);
-      out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      out.append(rb);
+      write_interior(
+          out, s.d.plane, [&](BspBuffer& o) { o.append(lb); }, [&](BspBuffer& o) { o.append(rb); });
     } else {
-      build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, out);
-      out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-      build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, out);
+      write_interior(
+          out, s.d.plane,
+          [&](BspBuffer& o) { build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, o); },
+          [&](BspBuffer& o) { build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, o); });
     }
+  }
+
+  /// Writes an interior node of plane into out, then its below subtree (below(out)) and its above one
+  /// (above(out)): the depth-first layout, the below child next to its parent.
+  template <class Below, class Above>
+  static void write_interior(BspBuffer& out, const BspPlane& plane, Below&& below, Above&& above) {
+    const size_t self = out.nodes.size();
+    const uint32_t index = uint32_t(out.payload.size());
+    out.payload.push_back(plane);
+    out.nodes.push_back(BspNode::leaf(0, 0));
+    below(out);
+    out.nodes[self] = BspNode::interior(index, uint32_t(out.nodes.size()));
+    above(out);
   }
 
   /// A node of the first attempt's breadth-first top (build_top).
@@ -365,29 +374,14 @@ class BspBuilder {
   /// Writes build_top's node i and its subtree into out in build_node's order.
   static void lay_out(const std::vector<TopNode>& t, uint32_t i, BspBuffer& out) {
     if (!t[i].split) return out.append(t[i].sub);
-    const size_t self = out.nodes.size();
-    const uint32_t plane = uint32_t(out.payload.size());
-    out.payload.push_back(t[i].plane);
-    out.nodes.push_back(BspNode::leaf(0, 0));
-    lay_out(t, t[i].below, out);
-    out.nodes[self] = BspNode::interior(plane, uint32_t(out.nodes.size()));
-    lay_out(t, t[i].above, out);
-  }
-
-  /// Signed-distance range of primitive k's support points from plane (dir, d).
-  static void range(const NodePrims& np, size_t k, const vec3& n, float d, float& lo, float& hi) {
-    lo = kInf;
-    hi = -kInf;
-    for (uint32_t j = np.start[k]; j < np.start[k + 1]; ++j) {
-      const float x = glm::dot(n, np.pts[j]) - d;
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
+    write_interior(
+        out, t[i].plane, [&](BspBuffer& o) { lay_out(t, t[i].below, o); },
+        [&](BspBuffer& o) { lay_out(t, t[i].above, o); });
   }
 
   /// The signed-distance ranges [lo[k], hi[k]] of every primitive's support points from the plane through
   /// the origin with normal n: every point's distance in one loop (vectorized), then each primitive's
-  /// extremes (range's values: the extremes of the distances, less d, are the extremes less d).
+  /// extremes (from a plane at offset d the ranges are these less d: subtracting d keeps the order).
   static void ranges(const NodePrims& np, const vec3& n, std::vector<float>& dots, float* lo, float* hi) {
     const size_t m = np.pts.size();
     dots.resize(m);
@@ -650,19 +644,16 @@ class BspBuilder {
     if (lo >= -0.5f * margin_) return 2;
     return 3;
   }
-  /// Side of primitive k (side_bits).
-  int side(const NodePrims& np, size_t k, const BspPlane& plane) const {
-    float lo, hi;
-    range(np, k, plane.n, plane.d, lo, hi);
-    return side_bits(lo, hi);
-  }
-
   /// Side bits of every primitive of the node against plane (side_bits), and the counts below and above.
   void classify(const NodePrims& np, const BspPlane& plane, std::vector<uint8_t>& sides, size_t& nl,
                 size_t& nr) const {
+    thread_local std::vector<float> dots, lo, hi;  // used only here: no call below builds a node
+    lo.resize(np.size());
+    hi.resize(np.size());
+    ranges(np, plane.n, dots, lo.data(), hi.data());
     sides.resize(np.size());
     for (size_t k = 0; k < np.size(); ++k) {
-      sides[k] = uint8_t(side(np, k, plane));
+      sides[k] = uint8_t(side_bits(lo[k] - plane.d, hi[k] - plane.d));
       nl += sides[k] & 1;
       nr += sides[k] >> 1;
     }
