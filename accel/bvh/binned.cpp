@@ -13,6 +13,7 @@
 
 #include "accel/bvh/binned_split.h"
 #include "accel/bvh/build.h"
+#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/sah_split.h"
 #include "accel/bvh/slots.h"
 #include "accel/common/binning.h"
@@ -34,8 +35,8 @@ class BinnedBuilder {
  public:
   BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds);
 
-  /// Builds the tree and returns the flattened result.
-  BvhBuildResult run();
+  /// Builds the tree and returns its slots and leaf order.
+  BvhSlotsResult run();
 
  private:
   void build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer);
@@ -47,15 +48,15 @@ class BinnedBuilder {
   const BvhSahConfig& config_;
   size_t n_;
   /// The references (buffer 0, which holds the final leaf order) and the second partition buffer;
-  /// uninitialized allocations (every element is written before it is read).
-  std::unique_ptr<BinRef[]> buffers_[2];
+  /// uninitialized and on huge pages (huge_pages.h; every element is written before it is read).
+  LargeArray<BinRef> buffers_[2];
   BvhSlots slots_;
 };
 
 BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds)
     : config_(config),
       n_(bounds.size()),
-      buffers_{std::make_unique_for_overwrite<BinRef[]>(n_), std::make_unique_for_overwrite<BinRef[]>(n_)},
+      buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
       slots_(n_) {
   BinRef* refs = buffers_[0].get();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
@@ -66,7 +67,7 @@ BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> b
   });
 }
 
-BvhBuildResult BinnedBuilder::run() {
+BvhSlotsResult BinnedBuilder::run() {
   const size_t n = n_;
   if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0, 0);
   std::vector<uint32_t> order(n);
@@ -74,7 +75,7 @@ BvhBuildResult BinnedBuilder::run() {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs[k].id;
   });
-  return flatten_bvh_slots(slots_, std::move(order));
+  return {std::move(slots_), std::move(order)};
 }
 
 NodeBounds BinnedBuilder::root_bounds() const {
@@ -200,8 +201,13 @@ void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint3
 
 }  // namespace
 
-BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {
+BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, std::span<const AABB> bounds) {
   return BinnedBuilder(config, bounds).run();
+}
+
+BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {
+  BvhSlotsResult built = build_bvh_slots(config, bounds);
+  return flatten_bvh_slots(built.slots, std::move(built.order));
 }
 
 }  // namespace ab

@@ -3,10 +3,11 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
+#include <span>
 #include <vector>
 
 #include "accel/bvh/build.h"
+#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/node.h"
 #include "accel/core/aabb.h"
 
@@ -17,12 +18,11 @@ namespace ab {
 /// can be built in parallel. A leaf stores offset b and count e - b; an interior node the right child's
 /// slot in offset and count 0. 2N - 1 slots hold any tree over N primitives.
 struct BvhSlots {
-  size_t size;                       ///< 2N - 1 (0 for no primitives)
-  std::unique_ptr<BvhNode[]> slots;  ///< uninitialized: only the slots of the tree are written and read
+  size_t size;                ///< 2N - 1 (0 for no primitives)
+  LargeArray<BvhNode> slots;  ///< uninitialized: only the slots of the tree are written and read
 
   /// Room for a tree over n primitives.
-  explicit BvhSlots(size_t n)
-      : size(n == 0 ? 0 : 2 * n - 1), slots(std::make_unique_for_overwrite<BvhNode[]>(size)) {}
+  explicit BvhSlots(size_t n) : size(n == 0 ? 0 : 2 * n - 1), slots(size) {}
   /// Writes the box of slot p.
   void set_box(uint32_t p, const AABB& box) {
     for (int a = 0; a < 3; ++a) {
@@ -40,6 +40,38 @@ struct BvhSlots {
     slots[p].offset = p + 2 * (m - b);
     slots[p].count = 0;
     return slots[p].offset;
+  }
+};
+
+/// A binned SAH build (binned.cpp) as its builder leaves it: the slots, root at slot 0, and the leaf order.
+struct BvhSlotsResult {
+  BvhSlots slots;               ///< the tree (size 0 for no primitives)
+  std::vector<uint32_t> order;  ///< order[k]: id of the k-th primitive in leaf order
+};
+
+/// The binned SAH build without the flattening (binned.cpp; build_bvh flattens this result), for the
+/// greedy collapse straight from the slots (collapse.h).
+BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, std::span<const AABB> bounds);
+
+/// A slot tree (not empty) as the one statistics walk (accel/common/tree_stats.h) sees it: the same
+/// nodes in the same order as BvhTreeVisitor over its flattened array.
+struct BvhSlotsVisitor {
+  using Node = uint32_t;  ///< slot index
+  const BvhSlots& tree;   ///< the slots
+
+  /// Slot 0.
+  Node root() const { return 0; }
+  /// The node's box.
+  AABB box(Node i) const { return tree.slots[i].box(); }
+  /// True for a leaf.
+  bool is_leaf(Node i) const { return tree.slots[i].is_leaf(); }
+  /// Primitives of a leaf.
+  uint32_t count(Node i) const { return tree.slots[i].count; }
+  /// The children, right first: the walk pops the last child first, so it goes left to right.
+  template <class F>
+  void children(Node i, F&& f) const {
+    f(tree.slots[i].offset);
+    f(i + 1);
   }
 };
 
