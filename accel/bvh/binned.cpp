@@ -93,7 +93,8 @@ void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& 
   const AABB box = nb.box.aabb();
   slots_.set_box(p, box);
   const uint32_t n = e - b;
-  if (depth >= config_.max_depth || n == 1) return make_leaf(p, b, e, buffer);
+  if (depth >= config_.max_depth || n == 1 || leaf_without_search(n, config_))
+    return make_leaf(p, b, e, buffer);
   const BinRef* refs = buffers_[buffer].get();
   // Small nodes use as many bins as primitives (at least 4): more could not separate them better on
   // average, and evaluating unused boundaries would dominate the cost near the leaves.

@@ -7,6 +7,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <bit>
@@ -233,8 +234,12 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
       });
       order_ = std::move(built.order);
       binary_ = BuildStats{};
-      if (built.slots.size > 0) walk_tree_stats(BvhSlotsVisitor{built.slots}, binary_);
-      wide_ = collapse_to_bvh8(built.slots);
+      // Both passes only read the slots, so the statistics walk and the collapse run side by side.
+      tbb::parallel_invoke(
+          [&] {
+            if (built.slots.size > 0) walk_tree_stats(BvhSlotsVisitor{built.slots}, binary_);
+          },
+          [&] { wide_ = collapse_to_bvh8(built.slots); });
       BvhNodeArray().swap(nodes_);
     }
   }
