@@ -3,11 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "accel/bvh/build.h"
-#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/node.h"
 #include "accel/core/aabb.h"
 
@@ -15,14 +15,18 @@ namespace ab {
 
 /// Slots of a binary tree under construction. The node of range [b, e) sits at slot p; when split at m its
 /// left child is at p + 1 and its right child at p + 2 (m - b), so disjoint subtrees never share a slot and
-/// can be built in parallel. A leaf stores offset b and count e - b; an interior node the right child's
+/// can be built in parallel (a subtree built serially may instead put its right child right after its left
+/// subtree: set_right). A leaf stores offset b and count e - b; an interior node the right child's
 /// slot in offset and count 0. 2N - 1 slots hold any tree over N primitives.
 struct BvhSlots {
-  size_t size;                ///< 2N - 1 (0 for no primitives)
-  LargeArray<BvhNode> slots;  ///< uninitialized: only the slots of the tree are written and read
+  size_t size;  ///< 2N - 1 (0 for no primitives)
+  /// Uninitialized: only the slots of the tree are written and read. Ordinary pages (not huge_pages.h):
+  /// the binned builder leaves most of the room untouched, and untouched 4 KiB pages are never zeroed.
+  std::unique_ptr<BvhNode[]> slots;
 
   /// Room for a tree over n primitives.
-  explicit BvhSlots(size_t n) : size(n == 0 ? 0 : 2 * n - 1), slots(size) {}
+  explicit BvhSlots(size_t n)
+      : size(n == 0 ? 0 : 2 * n - 1), slots(std::make_unique_for_overwrite<BvhNode[]>(size)) {}
   /// Writes the box of slot p.
   void set_box(uint32_t p, const AABB& box) {
     for (int a = 0; a < 3; ++a) {
@@ -34,6 +38,12 @@ struct BvhSlots {
   void set_leaf(uint32_t p, uint32_t b, uint32_t e) {
     slots[p].offset = b;
     slots[p].count = e - b;
+  }
+  /// Makes slot p an interior node whose right child is at slot `right` (a builder that lays a subtree out
+  /// compactly puts it right after the left child's subtree).
+  void set_right(uint32_t p, uint32_t right) {
+    slots[p].offset = right;
+    slots[p].count = 0;
   }
   /// Makes slot p (range starting at b) an interior node split at m; returns the right child's slot.
   uint32_t set_interior(uint32_t p, uint32_t b, uint32_t m) {
