@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "accel/bvh/build.h"
+#include "accel/bvh/collapse.h"
 #include "accel/bvh/sah_split.h"
 #include "accel/bvh/tree_visitors.h"
 #include "accel/common/tree_stats.h"
@@ -171,6 +172,31 @@ TEST(BvhBuild, FlattenedInDepthFirstPairOrder) {
   expect_depth_first_pairs(build_with<BvhSahConfig>(in, 2), "bvh-sah");
   expect_depth_first_pairs(build_with<BvhSweepConfig>(in, 2), "bvh-sweep");
   expect_depth_first_pairs(build_with<BvhMedianConfig>(in, 2), "bvh-median");
+}
+
+/// True when two arrays hold the same bytes.
+template <class A>
+bool same_bytes(const A& a, const A& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+}
+
+TEST(BvhBuild, BinnedSlotLayoutAndCollapseFromSlotsKeepTheTree) {
+  // The binned builder lays serial subtrees out compactly and parallel ones in gapped slots: with every
+  // node above the parallel threshold or every node below it, the flattened tree and the leaf order are
+  // the same, and the greedy collapse straight from the slots is the collapse of the flattened tree.
+  const Inputs in = inputs_of(random_soup(20000, 23, 0.02f));
+  BvhSahConfig compact, gapped;
+  compact.parallel_threshold = size_t(1) << 30;
+  gapped.parallel_threshold = 2;
+  const BvhBuildResult a = build_bvh(compact, in.bounds, in.centroids);
+  const BvhBuildResult b = build_bvh(gapped, in.bounds, in.centroids);
+  EXPECT_TRUE(same_bytes(a.nodes, b.nodes));
+  EXPECT_EQ(a.order, b.order);
+  for (const BvhSahConfig& config : {compact, gapped}) {
+    const BvhSlotsResult slots = build_bvh_slots(config, in.bounds);
+    EXPECT_EQ(slots.order, a.order);
+    EXPECT_TRUE(same_bytes(collapse_to_bvh8(slots.slots), collapse_to_bvh8(a.nodes)));
+  }
 }
 
 TEST(BvhBuild, BinnedChildBoxesAreTightAndLeavesAPermutation) {

@@ -13,6 +13,7 @@
 
 #include "accel/bvh/binned_split.h"
 #include "accel/bvh/build.h"
+#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/sah_split.h"
 #include "accel/bvh/slots.h"
 #include "accel/common/binning.h"
@@ -34,11 +35,19 @@ class BinnedBuilder {
  public:
   BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds);
 
-  /// Builds the tree and returns the flattened result.
-  BvhBuildResult run();
+  /// Builds the tree and returns its slots and leaf order.
+  BvhSlotsResult run();
 
  private:
-  void build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer);
+  /// The children of a split node: their bounds, the first reference of the right one and their buffer.
+  struct Children {
+    NodeBounds left, right;
+    uint32_t m = 0;
+    int buffer = 0;
+  };
+
+  uint32_t build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer);
+  bool split(uint32_t b, uint32_t e, const NodeBounds& nb, int buffer, Children& out);
   void make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer);
   void partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis, int position,
                  const BinMapping& map, Box4& left_c, Box4& right_c);
@@ -47,15 +56,15 @@ class BinnedBuilder {
   const BvhSahConfig& config_;
   size_t n_;
   /// The references (buffer 0, which holds the final leaf order) and the second partition buffer;
-  /// uninitialized allocations (every element is written before it is read).
-  std::unique_ptr<BinRef[]> buffers_[2];
+  /// uninitialized and on huge pages (huge_pages.h; every element is written before it is read).
+  LargeArray<BinRef> buffers_[2];
   BvhSlots slots_;
 };
 
 BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds)
     : config_(config),
       n_(bounds.size()),
-      buffers_{std::make_unique_for_overwrite<BinRef[]>(n_), std::make_unique_for_overwrite<BinRef[]>(n_)},
+      buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
       slots_(n_) {
   BinRef* refs = buffers_[0].get();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
@@ -66,7 +75,7 @@ BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> b
   });
 }
 
-BvhBuildResult BinnedBuilder::run() {
+BvhSlotsResult BinnedBuilder::run() {
   const size_t n = n_;
   if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0, 0);
   std::vector<uint32_t> order(n);
@@ -74,7 +83,7 @@ BvhBuildResult BinnedBuilder::run() {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs[k].id;
   });
-  return flatten_bvh_slots(slots_, std::move(order));
+  return {std::move(slots_), std::move(order)};
 }
 
 NodeBounds BinnedBuilder::root_bounds() const {
@@ -87,46 +96,61 @@ void BinnedBuilder::make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer) {
   if (buffer == 1) std::copy(buffers_[1].get() + b, buffers_[1].get() + e, buffers_[0].get() + b);
 }
 
-/// Builds the subtree of slot p over [b, e) of buffers_[buffer].
-void BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer) {
-  const AABB box = nb.box.aabb();
-  slots_.set_box(p, box);
+/// Splits [b, e) of buffers_[buffer] into children: at the cheapest bin boundary (partitioned into the
+/// other buffer) or, when no split is valid but the node is too large for a leaf, in the middle of the
+/// current order. Returns false when the node is a leaf.
+bool BinnedBuilder::split(uint32_t b, uint32_t e, const NodeBounds& nb, int buffer, Children& out) {
   const uint32_t n = e - b;
-  if (depth >= config_.max_depth || n == 1) return make_leaf(p, b, e, buffer);
   const BinRef* refs = buffers_[buffer].get();
   // Small nodes use as many bins as primitives (at least 4): more could not separate them better on
   // average, and evaluating unused boundaries would dominate the cost near the leaves.
   const BinMapping map(nb.centroids.aabb(), std::min(config_.bins, std::max(4, int(n))));
-  const BinnedSplit split = find_binned_split(refs, b, e, nb.box, map, config_.costs);
-  const uint32_t decision = sah_decision(n, split.sah, config_);
-  if (decision == 0) return make_leaf(p, b, e, buffer);
-  NodeBounds left, right;
-  uint32_t m;
-  int child_buffer = buffer;
+  const BinnedSplit found = find_binned_split(refs, b, e, nb.box, map, config_.costs);
+  const uint32_t decision = sah_decision(n, found.sah, config_);
+  if (decision == 0) return false;
+  out.buffer = buffer;
   if (decision == n) {
-    left.box = split.left;
-    right.box = split.right;
-    m = b + split.left_count;
-    child_buffer = 1 - buffer;
-    partition(refs, buffers_[child_buffer].get(), b, m, e, split.sah.axis, split.sah.position, map,
-              left.centroids, right.centroids);
+    out.left.box = found.left;
+    out.right.box = found.right;
+    out.m = b + found.left_count;
+    out.buffer = 1 - buffer;
+    partition(refs, buffers_[out.buffer].get(), b, out.m, e, found.sah.axis, found.sah.position, map,
+              out.left.centroids, out.right.centroids);
   } else {  // forced split in the middle of the current order
-    m = b + decision;
+    out.m = b + decision;
     for (uint32_t k = b; k < e; ++k) {
-      NodeBounds& side = k < m ? left : right;
+      NodeBounds& side = k < out.m ? out.left : out.right;
       side.box.extend(refs[k].lo4(), refs[k].hi4());
       side.centroids.extend(refs[k].center(), refs[k].center());
     }
   }
-  const uint32_t right_slot = slots_.set_interior(p, b, m);
-  auto build_left = [&] { build(p + 1, b, m, left, depth + 1, child_buffer); };
-  auto build_right = [&] { build(right_slot, m, e, right, depth + 1, child_buffer); };
-  if (n >= config_.parallel_threshold) {
-    tbb::parallel_invoke(build_left, build_right);
-  } else {
-    build_left();
-    build_right();
+  return true;
+}
+
+/// Builds the subtree of slot p over [b, e) of buffers_[buffer] and returns how many slots it takes. A node
+/// whose children are built in parallel gives them the gapped slots p + 1 and p + 2 (m - b) (slots.h); below
+/// parallel_threshold the subtree is laid out compactly, its right child in the slot after its left subtree,
+/// so the slots it leaves free are never touched (nor zeroed by the kernel) and the passes that read the
+/// slots (the collapse, the statistics walk, the flatten) read them densely. Either way the tree is the same.
+uint32_t BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth,
+                              int buffer) {
+  slots_.set_box(p, nb.box.aabb());
+  const uint32_t n = e - b;
+  Children c;
+  if (depth >= config_.max_depth || n == 1 || leaf_without_search(n, config_) ||
+      !split(b, e, nb, buffer, c)) {
+    make_leaf(p, b, e, buffer);
+    return 1;
   }
+  if (n >= config_.parallel_threshold) {
+    const uint32_t right_slot = slots_.set_interior(p, b, c.m);
+    tbb::parallel_invoke([&] { build(p + 1, b, c.m, c.left, depth + 1, c.buffer); },
+                         [&] { build(right_slot, c.m, e, c.right, depth + 1, c.buffer); });
+    return 2 * n - 1;
+  }
+  const uint32_t left_slots = build(p + 1, b, c.m, c.left, depth + 1, c.buffer);
+  slots_.set_right(p, p + 1 + left_slots);
+  return 1 + left_slots + build(p + 1 + left_slots, c.m, e, c.right, depth + 1, c.buffer);
 }
 
 /// Which side of the split a reference goes to: its bin on the split's axis (the binning's arithmetic on
@@ -200,8 +224,13 @@ void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint3
 
 }  // namespace
 
-BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {
+BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, std::span<const AABB> bounds) {
   return BinnedBuilder(config, bounds).run();
+}
+
+BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {
+  BvhSlotsResult built = build_bvh_slots(config, bounds);
+  return flatten_bvh_slots(built.slots, std::move(built.order));
 }
 
 }  // namespace ab

@@ -99,20 +99,43 @@ struct BinSet {
   explicit BinSet(int bins) : nb(bins) {
     for (int k = 0; k < 3 * nb; ++k) box[k] = Box4::empty(), count[k] = 0;
   }
+  /// Adds refs [b, e). A long range is binned into this set and a second one alternately and merged at
+  /// the end: consecutive references often fall into the same bins, and with one set each would wait for
+  /// the previous one's box update (a store-to-load chain). The sums and bounds are exact, so the bins are
+  /// the same either way.
   void add(const BinRef* refs, uint32_t b, uint32_t e, const BinIndexer& ix) {
-    for (uint32_t k = b; k < e; ++k) {
-      const __m128 lo = refs[k].lo4(), hi = refs[k].hi4();
-      alignas(16) int32_t bin[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(refs[k].center()));
-      for (int a = 0; a < 3; ++a) {
-        const int j = a * nb + bin[a];
-        box[j].extend(lo, hi);
-        ++count[j];
-      }
+    uint32_t k = b;
+    if (e - b < kTwoSetBinning) {
+      for (; k < e; ++k) put(refs[k], ix);
+      return;
     }
+    BinSet odd(nb);
+    for (; k + 1 < e; k += 2) {
+      put(refs[k], ix);
+      odd.put(refs[k + 1], ix);
+    }
+    if (k < e) put(refs[k], ix);
+    merge(odd);
   }
+  /// Adds the bins of o (exact: min, max and integer sums).
   void merge(const BinSet& o) {
     for (int k = 0; k < 3 * nb; ++k) box[k].extend(o.box[k]), count[k] += o.count[k];
+  }
+
+ private:
+  /// Ranges at least this long are binned into two sets.
+  static constexpr uint32_t kTwoSetBinning = 256;
+
+  /// Adds the reference to its bin on each axis.
+  void put(const BinRef& ref, const BinIndexer& ix) {
+    const __m128 lo = ref.lo4(), hi = ref.hi4();
+    alignas(16) int32_t bin[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(ref.center()));
+    for (int a = 0; a < 3; ++a) {
+      const int j = a * nb + bin[a];
+      box[j].extend(lo, hi);
+      ++count[j];
+    }
   }
 };
 

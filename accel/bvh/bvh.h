@@ -7,6 +7,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <bit>
@@ -19,10 +20,12 @@
 #include "accel/bvh/build.h"
 #include "accel/bvh/collapse.h"
 #include "accel/bvh/config.h"
+#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/leaf_blocks.h"
 #include "accel/bvh/node.h"
 #include "accel/bvh/node8.h"
 #include "accel/bvh/sbvh.h"
+#include "accel/bvh/slots.h"
 #include "accel/bvh/tree_visitors.h"
 #include "accel/bvh/walk2.h"
 #include "accel/bvh/walk8.h"
@@ -132,10 +135,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
 
   void do_build() override {
     bounds_ = current_prims().bounds();
-    BvhBuildResult result = build_bvh_over_prims();
-    nodes_ = std::move(result.nodes);
-    order_ = std::move(result.order);
-    if (config_.width == 8) collapse();
+    if (collapses_from_slots()) {
+      build_wide_from_slots();
+    } else {
+      BvhBuildResult result = build_bvh_over_prims();
+      nodes_ = std::move(result.nodes);
+      order_ = std::move(result.order);
+      if (config_.width == 8) collapse();
+    }
     if constexpr (kCopiesTriangles) {
       if (config_.width == 8) {
         blocks_ = pack_leaf_blocks(wide_, order_, *prims_);
@@ -181,22 +188,60 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   /// What a wide leaf is tested with: the ray broadcast to four lanes for triangle blocks, else the ray.
   using LeafRay = std::conditional_t<kCopiesTriangles, Ray4, Ray>;
 
-  /// Runs the Config's builder over the bounds and centroids of every primitive (gathered in parallel).
-  BvhBuildResult build_bvh_over_prims() const {
+  /// Calls build(bounds, centroids) with the bounds and centroids of every primitive, gathered in parallel
+  /// into uninitialized arrays (the binned and spatial-split builders read no centroids, so they get none).
+  template <class F>
+  auto over_prim_bounds(F&& build) const {
+    constexpr bool kCentroids = !kSpatialSplits && !std::is_same_v<C, BvhSahConfig>;
     const size_t n = prims_->size();
-    std::vector<AABB> boxes(n);
-    std::vector<vec3> centroids(n);
+    const LargeArray<AABB> boxes(n);
+    const LargeArray<vec3> centroids(kCentroids ? n : 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         boxes[i] = prims_->bounds(i);
-        centroids[i] = prims_->centroid(i);
+        if constexpr (kCentroids) centroids[i] = prims_->centroid(i);
       }
     });
-    if constexpr (kSpatialSplits)
-      return build_bvh(config_, boxes,
-                       [&](uint32_t i, const AABB& box) { return prims_->clipped_bounds(i, box); });
-    else
-      return build_bvh(config_, boxes, centroids);
+    return build(std::span<const AABB>(boxes.get(), n),
+                 std::span<const vec3>(centroids.get(), centroids.size()));
+  }
+
+  /// Runs the Config's builder over the bounds and centroids of every primitive.
+  BvhBuildResult build_bvh_over_prims() const {
+    return over_prim_bounds([&](std::span<const AABB> bounds, std::span<const vec3> centroids) {
+      if constexpr (kSpatialSplits)
+        return build_bvh(config_, bounds,
+                         [&](uint32_t i, const AABB& box) { return prims_->clipped_bounds(i, box); });
+      else
+        return build_bvh(config_, bounds, centroids);
+    });
+  }
+
+  /// True when the wide tree is the greedy collapse of a binned build, which collapses straight from the
+  /// builder's slots (no flattened binary tree).
+  bool collapses_from_slots() const {
+    if constexpr (std::is_same_v<C, BvhSahConfig>)
+      return config_.width == 8 && config_.collapse == BvhCollapse::greedy;
+    return false;
+  }
+
+  /// The binned build collapsed greedily from its slots, keeping the binary tree's figures for the report
+  /// (the statistics walk sees the slots' tree as it would see the flattened one).
+  void build_wide_from_slots() {
+    if constexpr (std::is_same_v<C, BvhSahConfig>) {
+      BvhSlotsResult built = over_prim_bounds([&](std::span<const AABB> bounds, std::span<const vec3>) {
+        return build_bvh_slots(config_, bounds);
+      });
+      order_ = std::move(built.order);
+      binary_ = BuildStats{};
+      // Both passes only read the slots, so the statistics walk and the collapse run side by side.
+      tbb::parallel_invoke(
+          [&] {
+            if (built.slots.size > 0) walk_tree_stats(BvhSlotsVisitor{built.slots}, binary_);
+          },
+          [&] { wide_ = collapse_to_bvh8(built.slots); });
+      BvhNodeArray().swap(nodes_);
+    }
   }
 
   /// Replaces the binary tree by its 8-wide collapse, keeping the binary tree's figures for the report.

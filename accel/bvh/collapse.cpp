@@ -7,6 +7,24 @@ namespace ab {
 
 namespace {
 
+/// A binary tree in build_bvh's layout: the children of interior node i are the pair offset, offset + 1.
+struct PairedTree {
+  const BvhNode* nodes;  ///< the node array
+
+  const BvhNode& operator[](uint32_t i) const { return nodes[i]; }
+  uint32_t left(uint32_t i) const { return nodes[i].offset; }
+  uint32_t right(uint32_t i) const { return nodes[i].offset + 1; }
+};
+
+/// A binary tree in the builders' slots (slots.h): the children of interior slot i are i + 1 and offset.
+struct SlotTree {
+  const BvhNode* nodes;  ///< the slots
+
+  const BvhNode& operator[](uint32_t i) const { return nodes[i]; }
+  uint32_t left(uint32_t i) const { return i + 1; }
+  uint32_t right(uint32_t i) const { return nodes[i].offset; }
+};
+
 /// The binary nodes that become one wide node's children (at most eight, no allocation).
 struct Kids {
   std::array<uint32_t, Bvh8Node::kWidth> id;
@@ -23,9 +41,10 @@ struct Kids {
 
 /// The greedy choice of a wide node's children (Wald, Benthin and Boulos 2008, section 3): open the interior
 /// child of largest area until there are eight.
+template <class Tree>
 class GreedyChildren {
  public:
-  explicit GreedyChildren(const BvhNodeArray& binary) : binary_(binary) {}
+  explicit GreedyChildren(const Tree& binary) : binary_(binary) {}
 
   /// Children of binary interior node b. Each child's area is computed once, when it becomes a child (a leaf
   /// counts as area -1, never opened).
@@ -38,8 +57,8 @@ class GreedyChildren {
       kids.insert(k, id);
       area[k] = area_of(id);
     };
-    put(0, binary_[b].offset);
-    put(1, binary_[b].offset + 1);
+    put(0, binary_.left(b));
+    put(1, binary_.right(b));
     while (kids.size() < size_t(Bvh8Node::kWidth)) {
       int pick = -1;
       float pick_area = -1.0f;
@@ -47,15 +66,15 @@ class GreedyChildren {
         if (area[k] > pick_area) pick = int(k), pick_area = area[k];
       if (pick < 0) break;
       const uint32_t opened = kids[size_t(pick)];
-      kids.id[size_t(pick)] = binary_[opened].offset;
-      area[size_t(pick)] = area_of(binary_[opened].offset);
-      put(size_t(pick) + 1, binary_[opened].offset + 1);
+      kids.id[size_t(pick)] = binary_.left(opened);
+      area[size_t(pick)] = area_of(binary_.left(opened));
+      put(size_t(pick) + 1, binary_.right(opened));
     }
     return kids;
   }
 
  private:
-  const BvhNodeArray& binary_;
+  const Tree& binary_;
 };
 
 // The SAH-optimal choice by dynamic programming over the binary tree (Ylitie, Karras and Laine 2017,
@@ -121,11 +140,12 @@ class OptimalChildren {
   std::vector<uint8_t> open_;   ///< the left child's lanes when n becomes a wide node
 };
 
-/// Recursive collapse of the binary tree into the wide array, with the children chosen by Children.
-template <class Children>
+/// Recursive collapse of the binary tree (PairedTree or SlotTree) into the wide array, with the children
+/// chosen by Children.
+template <class Tree, class Children>
 class Bvh8Collapser {
  public:
-  Bvh8Collapser(const BvhNodeArray& binary, const Children& children, Bvh8NodeArray& wide)
+  Bvh8Collapser(const Tree& binary, const Children& children, Bvh8NodeArray& wide)
       : binary_(binary), children_(children), wide_(wide) {}
 
   /// Collapses the whole tree (the binary root becomes the wide root's children, or its only leaf).
@@ -169,7 +189,7 @@ class Bvh8Collapser {
     }
   }
 
-  const BvhNodeArray& binary_;
+  const Tree& binary_;
   const Children& children_;
   Bvh8NodeArray& wide_;
 };
@@ -183,13 +203,26 @@ Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method) {
   Bvh8NodeArray wide;
   if (binary.empty()) return wide;
   wide.reserve(binary.size() / 4 + 1);
+  const PairedTree tree{binary.data()};
   if (method == BvhCollapse::optimal) {
     const OptimalChildren children(binary);
-    Bvh8Collapser(binary, children, wide).run();
+    Bvh8Collapser(tree, children, wide).run();
   } else {
-    const GreedyChildren children(binary);
-    Bvh8Collapser(binary, children, wide).run();
+    const GreedyChildren children(tree);
+    Bvh8Collapser(tree, children, wide).run();
   }
+  return wide;
+}
+
+// The greedy collapse straight from the slots: a slot tree and its flattened array have the same nodes and
+// the same left-to-right order of children, so the wide tree is the same node for node.
+Bvh8NodeArray collapse_to_bvh8(const BvhSlots& slots) {
+  Bvh8NodeArray wide;
+  if (slots.size == 0) return wide;
+  wide.reserve(slots.size / 4 + 1);
+  const SlotTree tree{slots.slots.get()};
+  const GreedyChildren children(tree);
+  Bvh8Collapser(tree, children, wide).run();
   return wide;
 }
 

@@ -4,6 +4,7 @@
 #include "accel/bvh/config.h"
 #include "accel/bvh/node.h"
 #include "accel/bvh/node8.h"
+#include "accel/bvh/slots.h"
 
 namespace ab {
 
@@ -14,5 +15,9 @@ namespace ab {
 /// programming). Leaves keep their primitive ranges. Node 0 is the root; when the binary root is a leaf, the
 /// wide root holds it as its only lane.
 Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method = BvhCollapse::greedy);
+
+/// The greedy collapse of a binary tree still in its builder's slots (slots.h; root at slot 0), without
+/// flattening it first: the same wide tree as flattening and then collapsing.
+Bvh8NodeArray collapse_to_bvh8(const BvhSlots& slots);
 
 }  // namespace ab

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 
+#include "accel/bvh/huge_pages.h"
+
 namespace ab {
 
 namespace {
@@ -33,6 +35,13 @@ void pack_node(Bvh8Node& node, uint32_t first, std::span<const uint32_t> order, 
   }
 }
 
+/// Reserves room for n elements, advised as huge pages (huge_pages.h) before the resize touches it.
+template <class T>
+void reserve_on_huge_pages(std::vector<T>& v, size_t n) {
+  v.reserve(n);
+  advise_huge_pages(v.data(), n * sizeof(T));
+}
+
 }  // namespace
 
 // The blocks are laid out node by node in lane order; each node's first block comes from a prefix sum, so
@@ -46,6 +55,8 @@ Bvh8LeafBlocks pack_leaf_blocks(Bvh8NodeArray& wide, std::span<const uint32_t> o
     first[i + 1] = first[i] + n;
   }
   Bvh8LeafBlocks out;
+  reserve_on_huge_pages(out.blocks, first.back());
+  reserve_on_huge_pages(out.ids, 4 * size_t(first.back()));
   out.blocks.resize(first.back());
   out.ids.resize(4 * size_t(first.back()));
   tbb::parallel_for(tbb::blocked_range<size_t>(0, wide.size(), 1024),

@@ -16,6 +16,15 @@ struct SahSplit {
   float cost = kInf;  ///< SAH cost of the split (SahCosts::split with the builder's costs)
 };
 
+/// True when a node of n primitives becomes a leaf whatever its split search would find, so the search can
+/// be skipped: n fits a leaf and the traversal cost alone is at least the leaf's cost. A split's cost is
+/// the traversal cost plus a sum of non-negative terms (its two sides are never empty), so it is never below
+/// the traversal cost, and sah_decision would make the same leaf. With blocks of four (width 8) this is every
+/// node of two to four primitives.
+inline bool leaf_without_search(uint32_t n, const BvhSahTreeConfig& config) {
+  return n <= uint32_t(config.max_leaf_size) && config.costs.traversal >= config.costs.leaf(n);
+}
+
 /// Leaf or split after an SAH search over a node of n primitives: returns 0 for a leaf, n / 2 for a forced
 /// split in the middle (no valid split but too many primitives for a leaf), and n for "split as found".
 /// A leaf is made when the SAH says splitting does not pay and the node holds at most max_leaf_size.
