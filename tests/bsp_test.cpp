@@ -238,6 +238,11 @@ TEST(Bsp, TheMinimumGainKeepsSplitsThatSaveTheTreeAlmostNothingLeaves) {
   EXPECT_EQ(count_differences("bsp", mesh, rays), 0u);
   EXPECT_EQ(count_differences("bsp", mesh, rays, {{"min_gain", "0"}}), 0u);
   EXPECT_EQ(count_differences("bsp", mesh, rays, {{"min_gain", "1000"}}), 0u);
+  // A soup far from the origin (1e6) keeps most of its splits, as near it: the cells' areas (the rays'
+  // shares) come from edge vectors, not from positions whose cross products cancel there.
+  const Mesh far = generate_mesh("far", 2000, 5, Params());
+  const BuildStats far_floor = built("bsp", far)->stats();
+  EXPECT_GT(10 * far_floor.nodes, 8 * built("bsp", far, {{"min_gain", "0"}})->stats().nodes);
 }
 
 TEST(Bsp, MatchesBruteOnObliqueGeometryAndRaysInObliquePlanes) {
