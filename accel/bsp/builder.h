@@ -49,6 +49,7 @@ class BspBuilder {
       }
       out = BspBuffer{};
       NodePrims root = gather_root(ids, box);
+      set_gain_floor(box, ids.size());
       count_frontier_root(ledger, root.size());
       if (ledger && config_.reuse_decisions)
         build_top(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, out);
@@ -163,6 +164,8 @@ class BspBuilder {
   Decision decide(const NodePrims& np, const ConvexCell& cell, const Depth& depth) const {
     const size_t n = np.size();
     if (n <= 1 || depth.splits >= depth_limit_ || depth.levels >= depth_limit_ + kEmptyCutLevels) return {};
+    const float share = ray_share(n, cell);
+    if (!pays(n, share, (1.0f - config_.costs.empty_bonus) * config_.costs.traversal)) return {};
     const bool shave_ok =
         config_.bad_refines == 0 || n <= kFreeShaveSize || depth.shaves + 1 < config_.bad_refines;
     Choices c = find_plane(np, cell, shave_ok, large_node(n));
@@ -171,10 +174,42 @@ class BspBuilder {
     // corner) only a plane through that vertex at another angle separates them.
     if (large_node(n) && !(c.best.cost < config_.costs.leaf(n)) && !(c.progress.cost < kInf))
       c = find_plane(np, cell, shave_ok, false);
-    if (c.best.cost < config_.costs.leaf(n)) return {c.best.plane, true, false};
+    if (c.best.cost < config_.costs.leaf(n) && pays(n, share, c.best.cost))
+      return {c.best.plane, true, false};
     if (config_.max_leaf > 0 && n > config_.max_leaf && c.progress.cost < kInf)
       return {c.progress.plane, true, true};
     return {};
+  }
+
+  /// The minimum-gain rule (min_gain). The SAH's expected cost of a tree is the sum over its nodes of the
+  /// chance that a ray through the root's cell reaches the node's, area(cell) / area(root), times the node's
+  /// own cost (MacDonald and Booth 1990, the expected-cost model; Goldsmith and Salmon 1987), and the greedy
+  /// SAH build splits a node whenever the split is cheaper than the leaf (Wald and Havran 2006's termination
+  /// criterion), however little that saves the tree. On thin geometry and fine tessellations most nodes hold
+  /// 2-15 pieces in cells so small that their splits save the tree less than a millionth of a test per ray,
+  /// and each costs microseconds to price (20k `needles`: 66 nodes per triangle). So a node of at most
+  /// max_leaf primitives splits only when share x (leaf - split) >= min_gain / N: a floor on the split's own
+  /// saving in the tree's expected cost per ray, scaled by 1 / N as the nodes' shares are. Each node it keeps
+  /// a leaf gives up less than min_gain / N of its best split's saving (its subtree's further splits are not
+  /// priced), and those nodes are leaves of the tree, so the tree's cost grows by less than min_gain x
+  /// leaves / N. A node whose share bounds every split's saving below the floor (no split costs less than
+  /// (1 - empty_bonus) x traversal) is a leaf without pricing its planes. The floor is ours (measured in
+  /// docs/structures.md), on the expected-cost model of the papers above.
+  void set_gain_floor(const AABB& box, size_t n) const {
+    root_area_ = ConvexCell::from_box(box).area();
+    gain_floor_ = config_.min_gain / float(std::max<size_t>(n, 1));
+  }
+  /// The node's share of the rays, area(cell) / area(root), when the minimum-gain rule applies to it (at
+  /// most max_leaf primitives, min_gain > 0, a root of some area); else -1.
+  float ray_share(size_t n, const ConvexCell& cell) const {
+    if (!(gain_floor_ > 0.0f && root_area_ > 0.0f) || (config_.max_leaf > 0 && n > config_.max_leaf))
+      return -1.0f;
+    return cell.area() / root_area_;
+  }
+  /// True when a split of a node of n primitives whose ray share is `share` at cost `split` (per unit of the
+  /// node's area) saves the tree at least the gain floor (always, when the rule does not apply: share < 0).
+  bool pays(size_t n, float share, float split) const {
+    return share < 0.0f || share * (config_.costs.leaf(n) - split) >= gain_floor_;
   }
 
   /// The first attempt's tree as the memo of the budgeted second attempt (build_with_budget): a node's
@@ -680,6 +715,8 @@ class BspBuilder {
   /// The first attempt's tree, during the second (memoized_decision).
   mutable const BspBuffer* memo_ = nullptr;
   mutable bool budget_exhausted_ = false;
+  mutable float root_area_ = 0.0f;   ///< the root cell's surface area (set_gain_floor)
+  mutable float gain_floor_ = 0.0f;  ///< min_gain / N (set_gain_floor; 0: the rule is off)
 };
 
 }  // namespace ab

@@ -172,8 +172,10 @@ class ConvexCell {
 
   /// Half the sum of the edge cross products: normal times area.
   static vec3 vector_area(std::span<const vec3> f) {
+    // Fanned from the first vertex (edge vectors, not positions): far from the origin (1e6, the `far`
+    // generator) the cross products of positions cancel to noise.
     vec3 s(0.0f);
-    for (size_t i = 0; i < f.size(); ++i) s += glm::cross(f[i], f[(i + 1) % f.size()]);
+    for (size_t i = 2; i < f.size(); ++i) s += glm::cross(f[i - 1] - f[0], f[i] - f[0]);
     return 0.5f * s;
   }
 
