@@ -114,6 +114,15 @@ class BspBuilder {
         bit == 1 ? HalfSpace{plane.n, plane.d + margin_} : HalfSpace{-plane.n, margin_ - plane.d};
     const bool oblique = is_oblique(plane);
     NodePrims out;
+    size_t count = 0, points = 0;
+    for (size_t k = 0; k < np.size(); ++k)
+      if (sides[k] & bit) {
+        ++count;
+        points += np.start[k + 1] - np.start[k];
+      }
+    out.ids.reserve(count);  // one allocation each (a clip adds a point or two per cut part)
+    out.start.reserve(count + 1);
+    out.pts.reserve(points + 2 * count);
     vec3 buf[kMaxSupportPoints];
     for (size_t k = 0; k < np.size(); ++k) {
       if (!(sides[k] & bit)) continue;
@@ -554,12 +563,13 @@ class BspBuilder {
       surface.areas(own.n, d, al, ar);
       size_t nl[3] = {0, 0, 0}, nr[3] = {0, 0, 0};
       ranges(np, own.n, scratch.dots, scratch.lo.data(), scratch.hi.data());
+      const float half = 0.5f * margin_;
       for (size_t i = 0; i < np.size(); ++i) {
         const float lo = scratch.lo[i] - own.d, hi = scratch.hi[i] - own.d;  // for the three planes, shifted
-        for (int m = 0; m < 3; ++m) {
-          const int s = side_bits(lo - (d[m] - own.d), hi - (d[m] - own.d));
-          nl[m] += s & 1;
-          nr[m] += s >> 1;
+        for (int m = 0; m < 3; ++m) {                                        // side_bits without branches
+          const bool below = hi - (d[m] - own.d) <= half, above = lo - (d[m] - own.d) >= -half;
+          nl[m] += size_t(below || !above);
+          nr[m] += size_t(!below);
         }
       }
       for (int m = 0; m < 3; ++m)
@@ -627,19 +637,29 @@ class BspBuilder {
       d.push_back(lo[j * n / k]);  // primitive j above only (side_bits)
       d.push_back(hi[j * n / k]);  // primitive j below only
     }
+    // The planes kCountLanes at a time (padded), primitive after primitive: the counts of a small node
+    // in a vector or two, without a scalar remainder or a sum over the lanes.
+    thread_local std::vector<float> x;  // used only here: no call below builds a node
+    thread_local std::vector<uint32_t> l, r;
+    const size_t count = d.size() - first, padded = (count + kCountLanes - 1) / kCountLanes * kCountLanes;
+    x.assign(padded, 0.0f);
+    std::copy(d.begin() + ptrdiff_t(first), d.end(), x.begin());
+    l.assign(padded, 0);
+    r.assign(padded, 0);
     const float half = 0.5f * margin_;
-    for (size_t j = first; j < d.size(); ++j) {
-      const float x = d[j];
-      uint32_t l = 0, r = 0;
-      for (size_t i = 0; i < n; ++i) {  // side_bits without branches (vectorized)
-        const bool below = hi[i] - x <= half, above = lo[i] - x >= -half;
-        l += uint32_t(below || !above);
-        r += uint32_t(!below);
+    for (size_t i = 0; i < n; ++i) {
+      const float a = lo[i], b = hi[i];
+      for (size_t j = 0; j < padded; ++j) {  // side_bits without branches (vectorized)
+        const bool below = b - x[j] <= half, above = a - x[j] >= -half;
+        l[j] += uint32_t(below || !above);
+        r[j] += uint32_t(!below);
       }
-      nl.push_back(l);
-      nr.push_back(r);
     }
+    nl.insert(nl.end(), l.begin(), l.begin() + ptrdiff_t(count));
+    nr.insert(nr.end(), r.begin(), r.begin() + ptrdiff_t(count));
   }
+  /// Planes exact_candidates counts at once (a vector of 16 floats).
+  static constexpr size_t kCountLanes = 16;
 
   /// The bin boundaries and the planes two margins outside the whole range, with binned counts.
   void binned_candidates(const std::vector<float>& lo, const std::vector<float>& hi, float range_lo,

@@ -30,6 +30,8 @@ class ConvexCell {
     const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
                              {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
     c.verts_.reserve(24);
+    c.starts_.reserve(7);
+    c.starts_.push_back(0);
     for (const auto& q : quads) {
       for (int k : q) c.verts_.push_back(corner(k));
       c.starts_.push_back(uint32_t(c.verts_.size()));
@@ -43,7 +45,7 @@ class ConvexCell {
   bool is_box() const { return box_; }
 
   /// Number of faces.
-  size_t face_count() const { return starts_.size() - 1; }
+  size_t face_count() const { return starts_.empty() ? 0 : starts_.size() - 1; }
   /// Face k's vertices.
   std::span<const vec3> face(size_t k) const {
     return {verts_.data() + starts_[k], verts_.data() + starts_[k + 1]};
@@ -137,6 +139,8 @@ class ConvexCell {
     }
     ConvexCell out;
     out.verts_.reserve(verts_.size() + 8);
+    out.starts_.reserve(face_count() + 2);
+    out.starts_.push_back(0);
     thread_local std::vector<vec3> cut;
     cut.clear();
     const float sign = below ? 1.0f : -1.0f;
@@ -232,10 +236,12 @@ class ConvexCell {
       out.pop_back();
   }
 
-  std::vector<vec3> verts_;          ///< every face's vertices, face after face
-  std::vector<uint32_t> starts_{0};  ///< face k is verts_[starts_[k], starts_[k + 1])
-  AABB bounds_;                      ///< bounds of verts_
-  bool box_ = false;                 ///< the faces are those of an axis-aligned box (from_box)
+  std::vector<vec3> verts_;  ///< every face's vertices, face after face
+  /// Face k is verts_[starts_[k], starts_[k + 1]); empty for an empty cell (no allocation for the empty
+  /// cells a split's parts start as).
+  std::vector<uint32_t> starts_;
+  AABB bounds_;       ///< bounds of verts_
+  bool box_ = false;  ///< the faces are those of an axis-aligned box (from_box)
 };
 
 /// The areas of a box cell cut by axis planes, in closed form (the k-d tree's SAH areas): the same
@@ -335,31 +341,33 @@ class CellSurface {
   /// plane within rounding of the cell's extent along n does not cut it (one part gets zero area).
   void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
     prepare(n);
-    float* cut = above;  // the cut face's area goes to above[] until the end
-    lanes_.resize(2 * kLanes * d.size());
-    for (size_t k = 0; k < d.size(); ++k) area_below(d[k], &lanes_[2 * kLanes * k]);
-    for (size_t k = 0; k < d.size(); ++k) {  // the planes' lane sums are independent: they overlap
-      const float* l = &lanes_[2 * kLanes * k];
-      float sb = 0.0f, sc = 0.0f;
-      for (size_t j = 0; j < kLanes; ++j) {
-        sb += l[j];
-        sc -= l[kLanes + j];
-      }
-      below[k] = sb;
-      cut[k] = sc;
-    }
+    // The planes that cut the cell, the others within rounding of its extent (no cut, as part).
+    thread_local std::vector<uint32_t> cutting;
+    cutting.clear();
     for (size_t k = 0; k < d.size(); ++k) {
-      if (!(d[k] > lowest_ + tol_)) {  // within rounding of the cell's lowest vertex: no cut (as part)
+      if (!(d[k] > lowest_ + tol_)) {
         below[k] = 0.0f;
         above[k] = total_;
       } else if (!(d[k] < highest_ - tol_)) {
         below[k] = total_;
         above[k] = 0.0f;
       } else {
-        const float x = std::max(cut[k], 0.0f);  // cut aliases above: read before writing
-        above[k] = std::max(total_ - below[k], 0.0f) + x;
-        below[k] += x;
+        cutting.push_back(uint32_t(k));
       }
+    }
+    lanes_.resize(2 * kLanes * cutting.size());
+    for (size_t q = 0; q < cutting.size(); ++q) area_below(d[cutting[q]], &lanes_[2 * kLanes * q]);
+    for (size_t q = 0; q < cutting.size(); ++q) {  // the planes' lane sums are independent: they overlap
+      const float* l = &lanes_[2 * kLanes * q];
+      float sb = 0.0f, sc = 0.0f;
+      for (size_t j = 0; j < kLanes; ++j) {
+        sb += l[j];
+        sc -= l[kLanes + j];
+      }
+      const size_t k = cutting[q];
+      const float x = std::max(sc, 0.0f);
+      above[k] = std::max(total_ - sb, 0.0f) + x;
+      below[k] = sb + x;
     }
   }
 
@@ -420,11 +428,16 @@ class CellSurface {
     std::array<float, kLanes> lo, hi;
     lo.fill(kInf);
     hi.fill(-kInf);
-    for (size_t i = 0; i < padded; i += kLanes)
+    block_low_.resize(padded / kLanes);
+    for (size_t i = 0; i < padded; i += kLanes) {
+      float block = kInf;
       for (size_t l = 0; l < kLanes; ++l) {
         lo[l] = std::min(lo[l], h0[i + l]);
         hi[l] = std::max(hi[l], h2[i + l]);
+        block = std::min(block, h0[i + l]);
       }
+      block_low_[i / kLanes] = block;
+    }
     lowest_ = *std::min_element(lo.begin(), lo.end());
     highest_ = *std::max_element(hi.begin(), hi.end());
   }
@@ -437,6 +450,9 @@ class CellSurface {
     const float *h0 = heights_.data(), *h1 = h0 + padded, *h2 = h1 + padded, *il = h2 + padded;
     const float *ih = il + padded, *area = ih + padded, *weighted = area + padded;
     for (size_t i = 0; i < padded; i += kLanes) {
+      // A block whose triangles all start at or above d adds zero to every lane (exactly: no lane's sum
+      // is ever -0), so it is skipped; block_low_ is its lowest h0.
+      if (!(d > block_low_[i / kLanes])) continue;
       for (size_t l = 0; l < kLanes; ++l) {
         // The fraction of the triangle's area below d, without branches (the reciprocal of a zero
         // denominator, and a padding lane's, is only ever in a lane the selects discard).
@@ -456,6 +472,7 @@ class CellSurface {
   std::array<std::vector<float>, kInFields> in_;  ///< the triangles, field by field
   size_t count_ = 0, padded_ = 0;                 ///< triangles, and rounded up to kLanes
   mutable std::vector<float> lanes_;              ///< areas()'s per-plane lane sums (area_below), kLanes each
+  mutable std::vector<float> block_low_;          ///< each block of kLanes triangles' lowest h0 along dir_
   mutable std::vector<float> heights_;  ///< prepare's fields for dir_, field by field (padded_ each)
   mutable vec3 dir_{0.0f};
   mutable bool prepared_ = false;
