@@ -20,15 +20,9 @@ struct CacheLineAllocator {
   template <class U>
   CacheLineAllocator(const CacheLineAllocator<U>&) {}
   /// Storage for n elements, 64-byte aligned (on huge pages from kHugePageBytes on).
-  T* allocate(size_t n) {
-    if (n * sizeof(T) >= kHugePageBytes) return static_cast<T*>(map_huge_pages(n * sizeof(T)));
-    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64)));
-  }
+  T* allocate(size_t n) { return static_cast<T*>(allocate_large(n * sizeof(T))); }
   /// Frees storage from allocate(n).
-  void deallocate(T* p, size_t n) {
-    if (n * sizeof(T) >= kHugePageBytes) return unmap_huge_pages(p, n * sizeof(T));
-    ::operator delete(p, std::align_val_t(64));
-  }
+  void deallocate(T* p, size_t n) { free_large(p, n * sizeof(T)); }
   /// Every instance can free every other's storage.
   bool operator==(const CacheLineAllocator&) const { return true; }
 };

@@ -39,6 +39,20 @@ inline void unmap_huge_pages(void* p, size_t) {
   ::operator delete(p, std::align_val_t(kHugePageBytes));
 }
 
+/// Uninitialized storage of `bytes`: on huge pages (map_huge_pages) from kHugePageBytes on, else 64-byte
+/// aligned from new. The one allocation rule of LargeArray and CacheLineAllocator.
+inline void* allocate_large(size_t bytes) {
+  if (bytes >= kHugePageBytes) return map_huge_pages(bytes);
+  return ::operator new(bytes, std::align_val_t(64));
+}
+
+/// Frees storage from allocate_large(bytes) (p may be null).
+inline void free_large(void* p, size_t bytes) {
+  if (p == nullptr) return;
+  if (bytes >= kHugePageBytes) return unmap_huge_pages(p, bytes);
+  ::operator delete(p, std::align_val_t(64));
+}
+
 /// Advises the whole huge pages within [p, p + bytes) (memory not yet touched, such as a vector's reserved
 /// storage) as transparent huge pages.
 inline void advise_huge_pages(void* p, size_t bytes) {
@@ -59,14 +73,14 @@ class LargeArray {
   /// No storage.
   LargeArray() = default;
   /// Room for n elements, uninitialized.
-  explicit LargeArray(size_t n) : size_(n), data_(allocate(n * sizeof(T))) {}
+  explicit LargeArray(size_t n) : size_(n), data_(static_cast<T*>(allocate_large(n * sizeof(T)))) {}
   LargeArray(LargeArray&& o) noexcept : size_(o.size_), data_(o.data_) { o.size_ = 0, o.data_ = nullptr; }
   LargeArray& operator=(LargeArray&& o) noexcept {
     std::swap(size_, o.size_);
     std::swap(data_, o.data_);
     return *this;
   }
-  ~LargeArray() { release(data_, size_ * sizeof(T)); }
+  ~LargeArray() { free_large(data_, size_ * sizeof(T)); }
 
   /// The elements.
   T* get() const { return data_; }
@@ -76,16 +90,6 @@ class LargeArray {
   size_t size() const { return size_; }
 
  private:
-  static T* allocate(size_t bytes) {
-    if (bytes >= kHugePageBytes) return static_cast<T*>(map_huge_pages(bytes));
-    return static_cast<T*>(::operator new(bytes, std::align_val_t(64)));
-  }
-  static void release(T* p, size_t bytes) {
-    if (p == nullptr) return;
-    if (bytes >= kHugePageBytes) return unmap_huge_pages(p, bytes);
-    ::operator delete(p, std::align_val_t(64));
-  }
-
   size_t size_ = 0;
   T* data_ = nullptr;
 };
