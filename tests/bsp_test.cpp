@@ -253,6 +253,8 @@ TEST(Bsp, MatchesBruteOnObliqueGeometryAndRaysInObliquePlanes) {
   EXPECT_EQ(count_differences("bsp", mesh, rays), 0u);
   EXPECT_EQ(count_differences("bsp", mesh, rays, {{"autopartition", "0"}, {"bins", "2"}}), 0u);
   EXPECT_EQ(count_differences("bsp", mesh, rays, {{"autopartition", "64"}, {"max_depth", "4"}}), 0u);
+  for (const char* k : {"3", "7", "9", "13"})  // every direction set, every node trying them
+    EXPECT_EQ(count_differences("bsp", mesh, rays, {{"directions", k}, {"oblique_max", "0"}}), 0u) << k;
 }
 
 TEST(Bsp, MatchesBruteOnAdversarialMeshesAndInstances) {
@@ -328,6 +330,8 @@ TEST(Bsp, RejectsBadParameters) {
   auto prims = std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(random_soup(10, 1)));
   EXPECT_THROW(make_accelerator("bsp", prims, testing::make_params({{"bins", "1"}})), ParamError);
   EXPECT_THROW(make_accelerator("bsp", prims, testing::make_params({{"leaf", "1"}})), ParamError);
+  EXPECT_THROW(make_accelerator("bsp", prims, testing::make_params({{"directions", "5"}})), ParamError);
+  EXPECT_THROW(make_accelerator("bsp", prims, testing::make_params({{"directions", "26"}})), ParamError);
 }
 
 }  // namespace

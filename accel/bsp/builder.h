@@ -501,7 +501,7 @@ class BspBuilder {
     if (nl < n && nr < n && c < ch.progress.cost) ch.progress = {plane, c};
   }
 
-  /// The buffers of binned_planes, kept over the 13 directions of a node.
+  /// The buffers of binned_planes, kept over the directions of a node.
   struct PlaneScratch {
     std::vector<float> lo, hi, d, al, ar;
     std::vector<uint32_t> nl, nr, starts, ends;
@@ -536,9 +536,10 @@ class BspBuilder {
     // exact-below switch of the SAH k-d tree builds (Hunt, Mark and Stoll 2006; Popov, Guenther, Seidel and
     // Slusallek 2006; discussed by Wald and Havran 2006) applied to the set of directions: a restricted BSP
     // (Kammaje and Mora 2007; Budge et al. 2008) whose restriction is the three axes above the size and the
-    // 13 directions and the triangles' own planes (Ize, Wald and Parker 2008) below it.
+    // `directions` fixed directions (of Kammaje and Mora's 13) and the triangles' own planes (Ize, Wald and
+    // Parker 2008) below it.
     const auto& dirs = bsp_directions();
-    for (size_t i = 0; i < (large ? 3 : dirs.size()); ++i)
+    for (size_t i : bsp_direction_set(large ? 3 : config_.directions))
       binned_planes(np, surface, cell_area, dirs[i], shave_ok, scratch, ch);
     if (!large) autopartition_planes(np, surface, cell_area, shave_ok, scratch, ch);
     return ch;

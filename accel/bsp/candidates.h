@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <concepts>
+#include <span>
 #include <vector>
 
 #include "accel/core/aabb.h"
@@ -53,6 +54,18 @@ inline const std::array<vec3, 13>& bsp_directions() {
     return out;
   }();
   return dirs;
+}
+
+/// The indices into bsp_directions() of a restricted BSP's k directions (Kammaje and Mora 2007 compare
+/// restricted BSP trees by their number of fixed directions): 3 the axes (a k-d tree's planes), 7 the axes
+/// and the 4 cube diagonals, 9 the axes and the 6 face diagonals, 13 all of them (any other k: 13).
+inline std::span<const size_t> bsp_direction_set(int k) {
+  static constexpr size_t all[13] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  static constexpr size_t cube[7] = {0, 1, 2, 9, 10, 11, 12};
+  if (k == 3) return {all, 3};
+  if (k == 7) return {cube, 7};
+  if (k == 9) return {all, 9};
+  return {all, 13};
 }
 
 /// Most support points a primitive can have in a cell (a triangle clipped by a box).

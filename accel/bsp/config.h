@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 
 #include "accel/common/leaf_refs.h"
 #include "accel/common/sah.h"
@@ -12,11 +13,13 @@ namespace ab {
 /// Configuration of the BSP tree.
 struct BspConfig {
   /// The cost model over the cell's surface area. Intersection 1.8 (measured on slivers: fewer triangles per
-  /// ray at about the same nodes); a small empty bonus, as 13 directions offer many corner cuts, each one
+  /// ray at about the same nodes); a small empty bonus, as many directions offer many corner cuts, each one
   /// more level.
   SahCosts costs{.traversal = 1.0f, .intersection = 1.8f, .empty_bonus = 0.05f};
   int bins = 16;          ///< plane positions per fixed direction: bins - 1
   int autopartition = 8;  ///< triangles whose supporting planes are tried per node
+  /// Fixed directions tried by nodes of at most oblique_max primitives: 3, 7, 9 or 13 (bsp_direction_set).
+  int directions = 13;
   /// Nodes of more primitives than this try only the three axes' binned planes (no diagonals, no
   /// autopartition), so their cells stay boxes (BspBuilder::find_plane; 0: every node tries all).
   size_t oblique_max = 1024;
@@ -52,6 +55,9 @@ struct BspConfig {
     params.read("empty_bonus", c.costs.empty_bonus, 0.0, 0.99);
     params.read("bins", c.bins, 2, 256);
     params.read("autopartition", c.autopartition, 0, 1024);
+    params.read("directions", c.directions, 3, 13);
+    if (c.directions != 3 && c.directions != 7 && c.directions != 9 && c.directions != 13)
+      throw ParamError("parameter 'directions': " + std::to_string(c.directions) + " is not 3, 7, 9 or 13");
     params.read("oblique_max", c.oblique_max, 0, size_t(1) << 30);
     params.read("max_depth", c.max_depth, 0, 100);
     params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
