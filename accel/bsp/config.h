@@ -19,10 +19,15 @@ struct BspConfig {
   int bins = 16;          ///< plane positions per fixed direction: bins - 1
   int autopartition = 8;  ///< triangles whose supporting planes are tried per node
   /// Fixed directions tried by nodes of at most oblique_max primitives: 3, 7, 9 or 13 (bsp_direction_set).
-  int directions = 13;
+  /// 9, the axes and the face diagonals (13 until issue 11: the 100k sphereflake's build 0.82x of the cpu
+  /// with 31.0 triangle tests per ray on 20k `needles` instead of 29.9, about the same on the sphereflake;
+  /// 7 tested 32.6 there, docs/structures.md).
+  int directions = 9;
   /// Nodes of more primitives than this try only the three axes' binned planes (no diagonals, no
-  /// autopartition), so their cells stay boxes (BspBuilder::find_plane; 0: every node tries all).
-  size_t oblique_max = 1024;
+  /// autopartition), so their cells stay boxes (BspBuilder::find_plane; 0: every node tries all). 32 (1024
+  /// until issue 11: the 100k sphereflake's build 0.69x of the cpu, the same triangle tests per ray, 7%
+  /// more nodes per ray; docs/structures.md).
+  size_t oblique_max = 32;
   int max_depth = 0;                           ///< depth limit; 0: auto_depth_limit of the primitive count
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   double ref_budget =
