@@ -358,13 +358,14 @@ class BspBuilder {
     t[0].cell = cell;
     t[0].depth = depth;
     const double limit = std::min(config_.ref_budget * double(t[0].np.size()), double(kTopRefs));
+    const size_t max_nodes = std::min(kTopNodesMax, t[0].np.size());
     std::vector<uint32_t> level{0};
     size_t previous = 0;  // the references of the level before
     while (!level.empty() && !ledger_->over()) {
       size_t refs = 0;
       for (uint32_t i : level) refs += t[i].np.size();
       const bool duplicating = double(refs) > kTopGrowth * double(previous);
-      if (double(refs) > limit || level.size() > kTopNodesMax || (level.size() > kTopNodes && !duplicating))
+      if (double(refs) > limit || level.size() > max_nodes || (level.size() > kTopNodes && !duplicating))
         break;
       previous = refs;
       std::vector<Step> steps(level.size());
@@ -719,15 +720,20 @@ class BspBuilder {
   static constexpr size_t kKeptScratchMax = 4096;
   /// Nodes at least this large build their children in parallel (BSP nodes are costly: split the work deep).
   static constexpr size_t kParallelMin = 256;
-  /// build_top's levels hold at most this many references (about 300 MB of clipped parts), so a 10M input's
-  /// root goes straight to the depth-first build; at least half of the 200k hostile inputs' budget.
-  static constexpr size_t kTopRefs = size_t(1) << 22;
-  /// build_top's levels hold at most kTopNodes nodes, or kTopNodesMax while each level holds more than
-  /// kTopGrowth times the references of the one before: a tree over the budget passes it within its first
+  /// build_top's levels hold at most this many references (about 600 MB of clipped parts), so a 10M input's
+  /// root goes straight to the depth-first build; more than the 200k hostile inputs' budget (6.4M), so a
+  /// tree over it is abandoned in the breadth-first top.
+  static constexpr size_t kTopRefs = size_t(1) << 23;
+  /// build_top's levels hold at most kTopNodes nodes, or kTopNodesMax (and N) while each level holds more
+  /// than kTopGrowth times the references of the one before: a tree over the budget passes it within its
   /// duplicating levels, and any other tree goes on depth first, with little memory (the same tree either
-  /// way: these bounds only choose the order of the work).
-  static constexpr size_t kTopNodes = 1024, kTopNodesMax = 16384;
-  static constexpr double kTopGrowth = 1.25;
+  /// way: these bounds only choose the order of the work). 200k `needles` copies 1.2x a level: with 1.25
+  /// and 16,384 the top handed on at 2,048 nodes and the depth-first build made 7.3M nodes before the
+  /// ledger passed the budget (32 s of 38); with 1.1 and 2^19 the top passes it at 114k nodes (7 s). At
+  /// most N nodes a level: 20k `needles`, within the budget, copies 1.2x a level to its leaves, and its
+  /// top held the whole tree (358 MB of build peak instead of 50).
+  static constexpr size_t kTopNodes = 1024, kTopNodesMax = size_t(1) << 19;
+  static constexpr double kTopGrowth = 1.1;
   const P& prims_;
   BspConfig config_;
   int depth_limit_;                      ///< resolved depth limit (> 0)
