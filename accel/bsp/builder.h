@@ -178,7 +178,7 @@ class BspBuilder {
     const bool shave_ok =
         config_.bad_refines == 0 || n <= kFreeShaveSize || depth.shaves + 1 < config_.bad_refines;
     Choices c = find_plane(np, cell, shave_ok, large_node(n));
-    // A large node whose axis planes neither beat the leaf nor make progress tries every direction and
+    // A large node whose axis planes neither beat the leaf nor make progress tries the `directions` and
     // the autopartition after all: at a fan's centre (every triangle shares a vertex at the cell's
     // corner) only a plane through that vertex at another angle separates them.
     if (large_node(n) && !(c.best.cost < config_.costs.leaf(n)) && !(c.progress.cost < kInf))
