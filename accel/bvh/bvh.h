@@ -66,11 +66,11 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   /// The 8-wide nodes (empty for width 2; for tests).
   const Bvh8NodeArray& wide_nodes() const { return wide_; }
   /// Original ids of the wide leaves' triangle block lanes (kInvalidId for padding; for tests).
-  const std::vector<uint32_t>& block_ids() const { return blocks_.ids; }
+  const BlockIdArray& block_ids() const { return blocks_.ids; }
   /// Primitive ids in leaf order (for tests).
   const std::vector<uint32_t>& order() const { return order_; }
   /// The wide leaves' triangle blocks (empty for width 2; for tests).
-  const std::vector<Triangle4>& leaf_blocks() const { return blocks_.blocks; }
+  const Triangle4Array& leaf_blocks() const { return blocks_.blocks; }
 
   /// Closest hit: front to back, nearer child first; a child is skipped only when its entry distance is
   /// strictly greater than best.t (the box tests' upper bound is min(tmax, best.t)).

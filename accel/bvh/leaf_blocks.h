@@ -6,16 +6,23 @@
 #include <span>
 #include <vector>
 
+#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/node8.h"
 #include "accel/core/primitives.h"
 #include "accel/core/triangle4.h"
 
 namespace ab {
 
+/// Leaf blocks in leaf order. Not zeroed by resize(): pack_leaf_blocks writes every block in parallel
+/// (huge_pages.h).
+using Triangle4Array = std::vector<Triangle4, UninitializedAllocator<Triangle4>>;
+/// The ids of the blocks' lanes, written as the blocks are.
+using BlockIdArray = std::vector<uint32_t, UninitializedAllocator<uint32_t>>;
+
 /// The triangle blocks of a wide tree's leaves and the original id of every block lane.
 struct Bvh8LeafBlocks {
-  std::vector<Triangle4> blocks;  ///< four triangles per block, a leaf's blocks consecutive
-  std::vector<uint32_t> ids;      ///< ids[4 * b + j]: id of lane j of block b (kInvalidId for padding)
+  Triangle4Array blocks;  ///< four triangles per block, a leaf's blocks consecutive
+  BlockIdArray ids;       ///< ids[4 * b + j]: id of lane j of block b (kInvalidId for padding)
 };
 
 /// Replaces each wide leaf's primitive range [child, child + count) of `order` by its blocks: lane child =
