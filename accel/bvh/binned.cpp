@@ -33,7 +33,7 @@ namespace {
 // parallel; the tree is the same for any number of threads.
 class BinnedBuilder {
  public:
-  BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds);
+  BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds);
 
   /// Builds the tree and returns its slots and leaf order.
   BvhSlotsResult run();
@@ -61,16 +61,21 @@ class BinnedBuilder {
   BvhSlots slots_;
 };
 
-BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds)
+BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds)
     : config_(config),
-      n_(bounds.size()),
+      n_(n),
       buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
       slots_(n_) {
   BinRef* refs = buffers_[0].get();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      const AABB& b = bounds[i];
-      refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+    AABB box[kBoundsBlock];  // a range may be longer than its grain: it is read block by block
+    for (size_t first = r.begin(); first < r.end(); first += kBoundsBlock) {
+      const size_t last = std::min(r.end(), first + kBoundsBlock);
+      bounds(first, last, box);
+      for (size_t i = first; i < last; ++i) {
+        const AABB& b = box[i - first];
+        refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+      }
     }
   });
 }
@@ -224,8 +229,14 @@ void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint3
 
 }  // namespace
 
+BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds) {
+  return BinnedBuilder(config, n, bounds).run();
+}
+
 BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, std::span<const AABB> bounds) {
-  return BinnedBuilder(config, bounds).run();
+  return build_bvh_slots(config, bounds.size(), [&](size_t begin, size_t end, AABB* out) {
+    std::copy(bounds.begin() + begin, bounds.begin() + end, out);
+  });
 }
 
 BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {

@@ -229,9 +229,11 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   /// (the statistics walk sees the slots' tree as it would see the flattened one).
   void build_wide_from_slots() {
     if constexpr (std::is_same_v<C, BvhSahConfig>) {
-      BvhSlotsResult built = over_prim_bounds([&](std::span<const AABB> bounds, std::span<const vec3>) {
-        return build_bvh_slots(config_, bounds);
-      });
+      // The primitives' bounds go straight into the builder's references (no array of all the bounds).
+      BvhSlotsResult built =
+          build_bvh_slots(config_, prims_->size(), [&](size_t begin, size_t end, AABB* out) {
+            for (size_t i = begin; i < end; ++i) out[i - begin] = prims_->bounds(i);
+          });
       order_ = std::move(built.order);
       binary_ = BuildStats{};
       // Both passes only read the slots, so the statistics walk and the collapse run side by side.
