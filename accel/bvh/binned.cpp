@@ -28,8 +28,8 @@ namespace {
 // range is partitioned at the cheapest one. The partition pass also computes the children's
 // centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. The
 // partition moves references between two buffers (a node's children live in the other buffer than the
-// node; a leaf left in the second buffer is copied back), so nothing is copied back per node. Nodes
-// above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
+// node), so nothing is copied back per node; a leaf writes its ids to the leaf order from either buffer.
+// Nodes above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
 // parallel; the tree is the same for any number of threads.
 class BinnedBuilder {
  public:
@@ -55,17 +55,20 @@ class BinnedBuilder {
 
   const BvhSahConfig& config_;
   size_t n_;
-  /// The references (buffer 0, which holds the final leaf order) and the second partition buffer;
-  /// uninitialized and on huge pages (huge_pages.h; every element is written before it is read).
+  /// The references and the second partition buffer; uninitialized and on huge pages (huge_pages.h; every
+  /// element is written before it is read).
   LargeArray<BinRef> buffers_[2];
   BvhSlots slots_;
+  /// The leaf order of the ids, written by make_leaf from whichever buffer holds the leaf.
+  std::vector<uint32_t> order_;
 };
 
 BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds)
     : config_(config),
       n_(n),
       buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
-      slots_(n_) {
+      slots_(n_),
+      order_(n_) {
   BinRef* refs = buffers_[0].get();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
     AABB box[kBoundsBlock];  // a range may be longer than its grain: it is read block by block
@@ -81,24 +84,20 @@ BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBou
 }
 
 BvhSlotsResult BinnedBuilder::run() {
-  const size_t n = n_;
-  if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0, 0);
-  std::vector<uint32_t> order(n);
-  const BinRef* refs = buffers_[0].get();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs[k].id;
-  });
-  return {std::move(slots_), std::move(order)};
+  if (n_ > 0) build(0, 0, uint32_t(n_), root_bounds(), 0, 0);
+  return {std::move(slots_), std::move(order_)};
 }
 
 NodeBounds BinnedBuilder::root_bounds() const {
   return bounds_of_refs(buffers_[0].get(), 0, n_);
 }
 
-/// A leaf over [b, e); its references are moved to buffer 0 if they are in buffer 1.
+/// A leaf over [b, e): its ids go to the leaf order from the buffer that holds them (no references are
+/// copied back to one buffer, and no pass over all of them extracts the order at the end).
 void BinnedBuilder::make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer) {
   slots_.set_leaf(p, b, e);
-  if (buffer == 1) std::copy(buffers_[1].get() + b, buffers_[1].get() + e, buffers_[0].get() + b);
+  const BinRef* refs = buffers_[buffer].get();
+  for (uint32_t k = b; k < e; ++k) order_[k] = refs[k].id;
 }
 
 /// Splits [b, e) of buffers_[buffer] into children: at the cheapest bin boundary (partitioned into the
