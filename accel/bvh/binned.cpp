@@ -51,7 +51,7 @@ class BinnedBuilder {
   void make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer);
   void partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis, int position,
                  const BinMapping& map, Box4& left_c, Box4& right_c);
-  NodeBounds root_bounds() const;
+  NodeBounds write_refs(const PrimBoundsSource& bounds);
 
   const BvhSahConfig& config_;
   size_t n_;
@@ -61,6 +61,8 @@ class BinnedBuilder {
   BvhSlots slots_;
   /// The leaf order of the ids, written by make_leaf from whichever buffer holds the leaf.
   std::vector<uint32_t> order_;
+  /// The root's box and centroid box, gathered while the references are written.
+  NodeBounds root_;
 };
 
 BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds)
@@ -69,8 +71,14 @@ BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBou
       buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
       slots_(n_),
       order_(n_) {
+  root_ = write_refs(bounds);
+}
+
+/// Writes the references of all primitives into buffer 0 and returns their box and centroid box, in the
+/// same pass (a parallel reduction of exact min / max, so the result does not depend on the threads).
+NodeBounds BinnedBuilder::write_refs(const PrimBoundsSource& bounds) {
   BinRef* refs = buffers_[0].get();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+  auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
     AABB box[kBoundsBlock];  // a range may be longer than its grain: it is read block by block
     for (size_t first = r.begin(); first < r.end(); first += kBoundsBlock) {
       const size_t last = std::min(r.end(), first + kBoundsBlock);
@@ -78,18 +86,24 @@ BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBou
       for (size_t i = first; i < last; ++i) {
         const AABB& b = box[i - first];
         refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+        acc.box.extend(refs[i].lo4(), refs[i].hi4());
+        const __m128 c = refs[i].center();
+        acc.centroids.extend(c, c);
       }
     }
-  });
+    return acc;
+  };
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, n_, kGrain), NodeBounds{}, body,
+                              [](NodeBounds x, const NodeBounds& y) {
+                                x.box.extend(y.box);
+                                x.centroids.extend(y.centroids);
+                                return x;
+                              });
 }
 
 BvhSlotsResult BinnedBuilder::run() {
-  if (n_ > 0) build(0, 0, uint32_t(n_), root_bounds(), 0, 0);
+  if (n_ > 0) build(0, 0, uint32_t(n_), root_, 0, 0);
   return {std::move(slots_), std::move(order_)};
-}
-
-NodeBounds BinnedBuilder::root_bounds() const {
-  return bounds_of_refs(buffers_[0].get(), 0, n_);
 }
 
 /// A leaf over [b, e): its ids go to the leaf order from the buffer that holds them (no references are
