@@ -63,37 +63,6 @@ inline void advise_huge_pages(void* p, size_t bytes) {
 #endif
 }
 
-/// Allocator of vectors that are resized first and then written in parallel (the leaf blocks): storage from
-/// allocate_large (huge pages from kHugePageBytes on) and a resize() that default-initializes, which for a
-/// trivial T leaves the memory untouched. The first write, and with it the page faults and the kernel's
-/// zeroing of the pages, then happens in the parallel pass that fills the elements, not serially in the
-/// resize (which would also write every byte once more).
-template <class T>
-struct UninitializedAllocator {
-  using value_type = T;  ///< the element type
-  /// A stateless allocator.
-  UninitializedAllocator() = default;
-  /// Rebinding from another element type.
-  template <class U>
-  UninitializedAllocator(const UninitializedAllocator<U>&) {}
-  /// Storage for n elements (allocate_large).
-  T* allocate(size_t n) { return static_cast<T*>(allocate_large(n * sizeof(T))); }
-  /// Frees storage from allocate(n).
-  void deallocate(T* p, size_t n) { free_large(p, n * sizeof(T)); }
-  /// Default-initializes *p (no write for a trivial U).
-  template <class U>
-  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  /// Constructs *p from args.
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-  /// Every instance can free every other's storage.
-  bool operator==(const UninitializedAllocator&) const { return true; }
-};
-
 /// A fixed-size array of trivially copyable T whose elements are not initialized (each is written before
 /// it is read); at least kHugePageBytes of them are mapped on huge pages, smaller ones come from new.
 template <class T>
