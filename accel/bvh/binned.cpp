@@ -171,18 +171,21 @@ uint32_t BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBoun
   return 1 + left_slots + build(p + 1 + left_slots, c.m, e, c.right, depth + 1, c.buffer);
 }
 
-/// Which side of the split a reference goes to: its bin on the split's axis (the binning's arithmetic on
-/// lane `axis` of center(), bit for bit) below the split's position.
+/// Which side of the split a reference goes to: its bin on the split's axis below the split's position, with
+/// the binning's own vector arithmetic (BinIndexer) on its centre, so bit for bit the bin it was counted in.
+/// The centre is the one the partition also folds into the sides' centroid bounds.
 struct SideTest {
-  float lo, scale;
-  int last, position, axis;
+  BinIndexer ix;
+  __m128i position;
+  int axis_bit;
 
   SideTest(const BinMapping& map, int a, int pos)
-      : lo(map.lo[a]), scale(map.scale[a]), last(map.bins - 1), position(pos), axis(a) {}
-  bool left(const BinRef& ref) const {
-    const float c_axis = (ref.lo[axis] + ref.hi[axis]) * 0.5f;
-    return std::clamp(int((c_axis - lo) * scale), 0, last) < position;
+      : ix(map), position(_mm_set1_epi32(pos)), axis_bit(1 << a) {}
+  bool left(__m128 center) const {
+    const __m128i below = _mm_cmplt_epi32(ix.bins(center), position);
+    return (_mm_movemask_ps(_mm_castsi128_ps(below)) & axis_bit) != 0;
   }
+  bool left(const BinRef& ref) const { return left(ref.center()); }
 };
 
 /// The centroid bounds of both sides of a partition.
@@ -199,11 +202,12 @@ SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t
   Box4 lc = Box4::empty(), rc = Box4::empty();
   for (uint32_t k = b; k < e; ++k) {
     const BinRef& ref = refs[k];
-    const bool left = side.left(ref);
+    const __m128 c = ref.center();
+    const bool left = side.left(c);
     out[left ? l : r] = ref;
     l += left;
     r += !left;
-    const __m128 c = ref.center(), mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
+    const __m128 mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
     lc.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
     rc.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
   }
