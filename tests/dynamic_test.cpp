@@ -171,7 +171,7 @@ void check_refit_from_mesh(int width) {
   const auto from_mesh = built_bvh<B>(base, width), from_prims = built_bvh<B>(base, width);
   // Refitted to the positions it was built over, the leaf blocks are the build's byte for byte (their terms,
   // made four lanes at once, are the bits the build's packing stores lane by lane).
-  const std::vector<Triangle4> built_blocks = from_mesh->leaf_blocks();
+  const Triangle4Array built_blocks = from_mesh->leaf_blocks();
   ASSERT_TRUE(from_mesh->refit(std::make_shared<const Mesh>(base)));
   EXPECT_TRUE(same_bytes(from_mesh->leaf_blocks(), built_blocks));
   std::shared_ptr<const TrianglePrims> prims;

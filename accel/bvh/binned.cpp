@@ -28,12 +28,12 @@ namespace {
 // range is partitioned at the cheapest one. The partition pass also computes the children's
 // centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. The
 // partition moves references between two buffers (a node's children live in the other buffer than the
-// node; a leaf left in the second buffer is copied back), so nothing is copied back per node. Nodes
-// above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
+// node), so nothing is copied back per node; a leaf writes its ids to the leaf order from either buffer.
+// Nodes above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
 // parallel; the tree is the same for any number of threads.
 class BinnedBuilder {
  public:
-  BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds);
+  BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds);
 
   /// Builds the tree and returns its slots and leaf order.
   BvhSlotsResult run();
@@ -51,49 +51,67 @@ class BinnedBuilder {
   void make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer);
   void partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis, int position,
                  const BinMapping& map, Box4& left_c, Box4& right_c);
-  NodeBounds root_bounds() const;
+  NodeBounds write_refs(const PrimBoundsSource& bounds);
 
   const BvhSahConfig& config_;
   size_t n_;
-  /// The references (buffer 0, which holds the final leaf order) and the second partition buffer;
-  /// uninitialized and on huge pages (huge_pages.h; every element is written before it is read).
+  /// The references and the second partition buffer; uninitialized and on huge pages (huge_pages.h; every
+  /// element is written before it is read).
   LargeArray<BinRef> buffers_[2];
   BvhSlots slots_;
+  /// The leaf order of the ids, written by make_leaf from whichever buffer holds the leaf.
+  std::vector<uint32_t> order_;
+  /// The root's box and centroid box, gathered while the references are written.
+  NodeBounds root_;
 };
 
-BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, std::span<const AABB> bounds)
+BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds)
     : config_(config),
-      n_(bounds.size()),
+      n_(n),
       buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
-      slots_(n_) {
+      slots_(n_),
+      order_(n_) {
+  root_ = write_refs(bounds);
+}
+
+/// Writes the references of all primitives into buffer 0 and returns their box and centroid box, in the
+/// same pass (a parallel reduction of exact min / max, so the result does not depend on the threads).
+NodeBounds BinnedBuilder::write_refs(const PrimBoundsSource& bounds) {
   BinRef* refs = buffers_[0].get();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      const AABB& b = bounds[i];
-      refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+  auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
+    AABB box[kBoundsBlock];  // a range may be longer than its grain: it is read block by block
+    for (size_t first = r.begin(); first < r.end(); first += kBoundsBlock) {
+      const size_t last = std::min(r.end(), first + kBoundsBlock);
+      bounds(first, last, box);
+      for (size_t i = first; i < last; ++i) {
+        const AABB& b = box[i - first];
+        refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+        acc.box.extend(refs[i].lo4(), refs[i].hi4());
+        const __m128 c = refs[i].center();
+        acc.centroids.extend(c, c);
+      }
     }
-  });
+    return acc;
+  };
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, n_, kGrain), NodeBounds{}, body,
+                              [](NodeBounds x, const NodeBounds& y) {
+                                x.box.extend(y.box);
+                                x.centroids.extend(y.centroids);
+                                return x;
+                              });
 }
 
 BvhSlotsResult BinnedBuilder::run() {
-  const size_t n = n_;
-  if (n > 0) build(0, 0, uint32_t(n), root_bounds(), 0, 0);
-  std::vector<uint32_t> order(n);
-  const BinRef* refs = buffers_[0].get();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k < r.end(); ++k) order[k] = refs[k].id;
-  });
-  return {std::move(slots_), std::move(order)};
+  if (n_ > 0) build(0, 0, uint32_t(n_), root_, 0, 0);
+  return {std::move(slots_), std::move(order_)};
 }
 
-NodeBounds BinnedBuilder::root_bounds() const {
-  return bounds_of_refs(buffers_[0].get(), 0, n_);
-}
-
-/// A leaf over [b, e); its references are moved to buffer 0 if they are in buffer 1.
+/// A leaf over [b, e): its ids go to the leaf order from the buffer that holds them (no references are
+/// copied back to one buffer, and no pass over all of them extracts the order at the end).
 void BinnedBuilder::make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer) {
   slots_.set_leaf(p, b, e);
-  if (buffer == 1) std::copy(buffers_[1].get() + b, buffers_[1].get() + e, buffers_[0].get() + b);
+  const BinRef* refs = buffers_[buffer].get();
+  for (uint32_t k = b; k < e; ++k) order_[k] = refs[k].id;
 }
 
 /// Splits [b, e) of buffers_[buffer] into children: at the cheapest bin boundary (partitioned into the
@@ -153,18 +171,21 @@ uint32_t BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBoun
   return 1 + left_slots + build(p + 1 + left_slots, c.m, e, c.right, depth + 1, c.buffer);
 }
 
-/// Which side of the split a reference goes to: its bin on the split's axis (the binning's arithmetic on
-/// lane `axis` of center(), bit for bit) below the split's position.
+/// Which side of the split a reference goes to: its bin on the split's axis below the split's position, with
+/// the binning's own vector arithmetic (BinIndexer) on its centre, so bit for bit the bin it was counted in.
+/// The centre is the one the partition also folds into the sides' centroid bounds.
 struct SideTest {
-  float lo, scale;
-  int last, position, axis;
+  BinIndexer ix;
+  __m128i position;
+  int axis_bit;
 
   SideTest(const BinMapping& map, int a, int pos)
-      : lo(map.lo[a]), scale(map.scale[a]), last(map.bins - 1), position(pos), axis(a) {}
-  bool left(const BinRef& ref) const {
-    const float c_axis = (ref.lo[axis] + ref.hi[axis]) * 0.5f;
-    return std::clamp(int((c_axis - lo) * scale), 0, last) < position;
+      : ix(map), position(_mm_set1_epi32(pos)), axis_bit(1 << a) {}
+  bool left(__m128 center) const {
+    const __m128i below = _mm_cmplt_epi32(ix.bins(center), position);
+    return (_mm_movemask_ps(_mm_castsi128_ps(below)) & axis_bit) != 0;
   }
+  bool left(const BinRef& ref) const { return left(ref.center()); }
 };
 
 /// The centroid bounds of both sides of a partition.
@@ -181,11 +202,12 @@ SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t
   Box4 lc = Box4::empty(), rc = Box4::empty();
   for (uint32_t k = b; k < e; ++k) {
     const BinRef& ref = refs[k];
-    const bool left = side.left(ref);
+    const __m128 c = ref.center();
+    const bool left = side.left(c);
     out[left ? l : r] = ref;
     l += left;
     r += !left;
-    const __m128 c = ref.center(), mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
+    const __m128 mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
     lc.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
     rc.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
   }
@@ -224,8 +246,14 @@ void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint3
 
 }  // namespace
 
+BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds) {
+  return BinnedBuilder(config, n, bounds).run();
+}
+
 BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, std::span<const AABB> bounds) {
-  return BinnedBuilder(config, bounds).run();
+  return build_bvh_slots(config, bounds.size(), [&](size_t begin, size_t end, AABB* out) {
+    std::copy(bounds.begin() + begin, bounds.begin() + end, out);
+  });
 }
 
 BvhBuildResult build_bvh(const BvhSahConfig& config, std::span<const AABB> bounds, std::span<const vec3>) {

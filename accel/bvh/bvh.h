@@ -66,11 +66,11 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   /// The 8-wide nodes (empty for width 2; for tests).
   const Bvh8NodeArray& wide_nodes() const { return wide_; }
   /// Original ids of the wide leaves' triangle block lanes (kInvalidId for padding; for tests).
-  const std::vector<uint32_t>& block_ids() const { return blocks_.ids; }
+  const BlockIdArray& block_ids() const { return blocks_.ids; }
   /// Primitive ids in leaf order (for tests).
   const std::vector<uint32_t>& order() const { return order_; }
   /// The wide leaves' triangle blocks (empty for width 2; for tests).
-  const std::vector<Triangle4>& leaf_blocks() const { return blocks_.blocks; }
+  const Triangle4Array& leaf_blocks() const { return blocks_.blocks; }
 
   /// Closest hit: front to back, nearer child first; a child is skipped only when its entry distance is
   /// strictly greater than best.t (the box tests' upper bound is min(tmax, best.t)).
@@ -229,9 +229,11 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
   /// (the statistics walk sees the slots' tree as it would see the flattened one).
   void build_wide_from_slots() {
     if constexpr (std::is_same_v<C, BvhSahConfig>) {
-      BvhSlotsResult built = over_prim_bounds([&](std::span<const AABB> bounds, std::span<const vec3>) {
-        return build_bvh_slots(config_, bounds);
-      });
+      // The primitives' bounds go straight into the builder's references (no array of all the bounds).
+      BvhSlotsResult built =
+          build_bvh_slots(config_, prims_->size(), [&](size_t begin, size_t end, AABB* out) {
+            for (size_t i = begin; i < end; ++i) out[i - begin] = prims_->bounds(i);
+          });
       order_ = std::move(built.order);
       binary_ = BuildStats{};
       // Both passes only read the slots, so the statistics walk and the collapse run side by side.

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -62,6 +63,16 @@ struct BvhSlotsResult {
 /// The binned SAH build without the flattening (binned.cpp; build_bvh flattens this result), for the
 /// greedy collapse straight from the slots (collapse.h).
 BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, std::span<const AABB> bounds);
+
+/// Writes the bounds of primitives [begin, end) to out[0, end - begin); called in parallel on disjoint
+/// ranges of at most kBoundsBlock primitives.
+using PrimBoundsSource = std::function<void(size_t begin, size_t end, AABB* out)>;
+/// The largest range a PrimBoundsSource is asked for.
+inline constexpr size_t kBoundsBlock = 512;
+
+/// The same build over n primitives whose bounds come from `bounds` block by block, straight into the
+/// builder's references (no array of all the bounds is made, written and read again).
+BvhSlotsResult build_bvh_slots(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds);
 
 /// A slot tree (not empty) as the one statistics walk (accel/common/tree_stats.h) sees it: the same
 /// nodes in the same order as BvhTreeVisitor over its flattened array.
