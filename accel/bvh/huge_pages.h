@@ -7,7 +7,6 @@
 #include <sys/mman.h>
 
 #include <cstddef>
-#include <cstdint>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -51,16 +50,6 @@ inline void free_large(void* p, size_t bytes) {
   if (p == nullptr) return;
   if (bytes >= kHugePageBytes) return unmap_huge_pages(p, bytes);
   ::operator delete(p, std::align_val_t(64));
-}
-
-/// Advises the whole huge pages within [p, p + bytes) (memory not yet touched, such as a vector's reserved
-/// storage) as transparent huge pages.
-inline void advise_huge_pages(void* p, size_t bytes) {
-#ifdef MADV_HUGEPAGE
-  const uintptr_t begin = (uintptr_t(p) + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
-  const uintptr_t end = (uintptr_t(p) + bytes) & ~(kHugePageBytes - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#endif
 }
 
 /// A fixed-size array of trivially copyable T whose elements are not initialized (each is written before
