@@ -5,6 +5,7 @@
 namespace ab {
 namespace {
 const Registrar kRegisterBsp{structure_info<BspTree>(
-    "bsp", "BSP tree, arbitrary planes (13 directions + triangles' own planes), SAH over the cell", 35)};
+    "bsp",
+    "BSP tree, arbitrary planes (up to 13 fixed directions + triangles' own planes), SAH over the cell", 35)};
 }  // namespace
 }  // namespace ab
