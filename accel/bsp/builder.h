@@ -10,6 +10,7 @@
 // any thread count).
 #pragma once
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
@@ -96,11 +97,52 @@ class BspBuilder {
   /// The root's primitives, clipped to the root box.
   NodePrims gather_root(const std::vector<uint32_t>& ids, const AABB& box) const {
     const AABB g = grown(box);
-    NodePrims np;
-    vec3 buf[kMaxSupportPoints];
-    for (uint32_t id : ids)
-      if (const int k = support_points(prims_, id, g, buf); k > 0) np.add(id, buf, k);
-    return np;
+    return collect(ids.size(), [&](size_t k, uint32_t& id, vec3* buf) {
+      id = ids[k];
+      return support_points(prims_, id, g, buf);
+    });
+  }
+
+  /// The primitives k < count for which part(k, id, points) gives an id and points (their count; 0: the
+  /// primitive is left out), in k's order. A large node's are made in chunks in parallel and joined (the
+  /// same result: at 10M triangles the root's and the top levels' clipping ran on one core).
+  template <class Part>
+  NodePrims collect(size_t count, Part&& part) const {
+    const size_t chunks = count >= kParallelPrims ? (count + kParallelGrain - 1) / kParallelGrain : 1;
+    std::vector<NodePrims> pieces(chunks);
+    auto fill = [&](size_t c) {
+      vec3 buf[kMaxSupportPoints];
+      uint32_t id = 0;
+      for (size_t k = c * count / chunks, end = (c + 1) * count / chunks; k < end; ++k)
+        if (const int m = part(k, id, buf); m > 0) pieces[c].add(id, buf, m);
+    };
+    if (chunks == 1) {
+      fill(0);
+      return std::move(pieces[0]);
+    }
+    tbb::parallel_for(size_t(0), chunks, fill);
+    return join(pieces);
+  }
+
+  /// The pieces' primitives one after another (collect), copied in parallel.
+  static NodePrims join(const std::vector<NodePrims>& pieces) {
+    std::vector<size_t> ids_at(pieces.size() + 1, 0), pts_at(pieces.size() + 1, 0);
+    for (size_t c = 0; c < pieces.size(); ++c) {
+      ids_at[c + 1] = ids_at[c] + pieces[c].size();
+      pts_at[c + 1] = pts_at[c] + pieces[c].pts.size();
+    }
+    NodePrims out;
+    out.ids.resize(ids_at.back());
+    out.start.resize(ids_at.back() + 1);
+    out.pts.resize(pts_at.back());
+    tbb::parallel_for(size_t(0), pieces.size(), [&](size_t c) {
+      const NodePrims& p = pieces[c];
+      std::copy(p.ids.begin(), p.ids.end(), out.ids.begin() + ptrdiff_t(ids_at[c]));
+      std::copy(p.pts.begin(), p.pts.end(), out.pts.begin() + ptrdiff_t(pts_at[c]));
+      for (size_t k = 0; k < p.size(); ++k)
+        out.start[ids_at[c] + k + 1] = uint32_t(pts_at[c] + p.start[k + 1]);
+    });
+    return out;
   }
 
   /// The primitives of the child on side `bit` (1 below, 2 above) of plane, whose cell is `cell`. A
@@ -113,6 +155,11 @@ class BspBuilder {
     const HalfSpace cut =
         bit == 1 ? HalfSpace{plane.n, plane.d + margin_} : HalfSpace{-plane.n, margin_ - plane.d};
     const bool oblique = is_oblique(plane);
+    if (np.size() >= kParallelPrims)
+      return collect(np.size(), [&](size_t k, uint32_t& id, vec3* buf) {
+        id = np.ids[k];
+        return (sides[k] & bit) ? part_in_child(np, k, oblique ? &cut : nullptr, box, buf) : 0;
+      });
     NodePrims out;
     size_t count = 0, points = 0;
     for (size_t k = 0; k < np.size(); ++k)
@@ -126,15 +173,20 @@ class BspBuilder {
     vec3 buf[kMaxSupportPoints];
     for (size_t k = 0; k < np.size(); ++k) {
       if (!(sides[k] & bit)) continue;
-      int m = 0;
-      if constexpr (std::is_same_v<P, TrianglePrims>) {
-        m = clip_part(np, k, oblique ? &cut : nullptr, box, buf);
-      } else {
-        m = support_points(prims_, np.ids[k], box, buf);
-      }
-      if (m > 0) out.add(np.ids[k], buf, m);
+      if (const int m = part_in_child(np, k, oblique ? &cut : nullptr, box, buf); m > 0)
+        out.add(np.ids[k], buf, m);
     }
     return out;
+  }
+
+  /// Primitive k's part in a child cut by half-space cut (given for an oblique plane) of grown box box: a
+  /// triangle's part clipped (clip_part), another primitive's support points in box.
+  int part_in_child(const NodePrims& np, size_t k, const HalfSpace* cut, const AABB& box, vec3* out) const {
+    if constexpr (std::is_same_v<P, TrianglePrims>) {
+      return clip_part(np, k, cut, box, out);
+    } else {
+      return support_points(prims_, np.ids[k], box, out);
+    }
   }
 
   /// Primitive k's part clipped by half-space cut (when given) and box, into out. Leaves a clip out (keeping
@@ -307,11 +359,18 @@ class BspBuilder {
     np = NodePrims{};
     const uint32_t lat = memo_child(at, 0), rat = memo_child(at, 1);
     if (n >= kParallelMin) {
-      BspBuffer lb, rb;
-      tbb::parallel_invoke([&] { build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, lb); },
-                           [&] { build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, rb); });
+      // The below subtree goes straight into out, after this node, as the serial build writes it; only
+      // the above one is built into a buffer of its own and appended (each subtree was copied at every
+      // parallel level above it: at 10M triangles 15 levels of the whole tree's nodes).
+      BspBuffer rb;
       write_interior(
-          out, s.d.plane, [&](BspBuffer& o) { o.append(lb); }, [&](BspBuffer& o) { o.append(rb); });
+          out, s.d.plane,
+          [&](BspBuffer& o) {
+            tbb::parallel_invoke(
+                [&] { build_node(std::move(c.prims[0]), c.cells[0], c.depths[0], lat, o); },
+                [&] { build_node(std::move(c.prims[1]), c.cells[1], c.depths[1], rat, rb); });
+          },
+          [&](BspBuffer& o) { o.append(rb); });
     } else {
       write_interior(
           out, s.d.plane,
@@ -428,6 +487,22 @@ class BspBuilder {
   /// the origin with normal n: every point's distance in one loop (vectorized), then each primitive's
   /// extremes (from a plane at offset d the ranges are these less d: subtracting d keeps the order).
   static void ranges(const NodePrims& np, const vec3& n, std::vector<float>& dots, float* lo, float* hi) {
+    if (np.size() >= kParallelPrims) {  // a large node's in parallel, each point's distance as below
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, np.size(), kParallelGrain), [&](const auto& r) {
+        for (size_t k = r.begin(); k < r.end(); ++k) {
+          float a = kInf, b = -kInf;
+          for (uint32_t j = np.start[k]; j < np.start[k + 1]; ++j) {
+            const vec3& p = np.pts[j];
+            const float t = n.x * p.x + n.y * p.y + n.z * p.z;
+            a = std::min(a, t);
+            b = std::max(b, t);
+          }
+          lo[k] = a;
+          hi[k] = b;
+        }
+      });
+      return;
+    }
     const size_t m = np.pts.size();
     dots.resize(m);
     const vec3* __restrict p = np.pts.data();
@@ -720,6 +795,9 @@ class BspBuilder {
   static constexpr size_t kKeptScratchMax = 4096;
   /// Nodes at least this large build their children in parallel (BSP nodes are costly: split the work deep).
   static constexpr size_t kParallelMin = 256;
+  /// Nodes of at least kParallelPrims primitives clip them and measure their ranges in parallel, in chunks
+  /// of about kParallelGrain (collect, ranges).
+  static constexpr size_t kParallelPrims = size_t(1) << 16, kParallelGrain = size_t(1) << 14;
   /// build_top's levels hold at most this many references (about 600 MB of clipped parts), so a 10M input's
   /// root goes straight to the depth-first build; more than the 200k hostile inputs' budget (6.4M), so a
   /// tree over it is abandoned in the breadth-first top.
