@@ -504,7 +504,7 @@ class BspBuilder {
       return;
     }
     const size_t m = np.pts.size();
-    dots.resize(m);
+    grow_buffer(dots, m);
     const vec3* __restrict p = np.pts.data();
     float* __restrict out = dots.data();
     const float x = n.x, y = n.y, z = n.z;
@@ -628,8 +628,8 @@ class BspBuilder {
   void autopartition_planes(const NodePrims& np, const CellSurface& surface, const CellArea& cell_area,
                             bool shave_ok, PlaneScratch& scratch, Choices& ch) const {
     const size_t k = std::min<size_t>(np.size(), size_t(config_.autopartition));
-    scratch.lo.resize(np.size());
-    scratch.hi.resize(np.size());
+    grow_buffer(scratch.lo, np.size());
+    grow_buffer(scratch.hi, np.size());
     for (size_t j = 0; j < k; ++j) {
       BspPlane own;
       if (!supporting_plane(prims_, np.ids[j * np.size() / k], own)) continue;
@@ -666,8 +666,8 @@ class BspBuilder {
     const size_t n = np.size();
     std::vector<float>&lo = s.lo, &hi = s.hi, &d = s.d, &al = s.al, &ar = s.ar;
     std::vector<uint32_t>&nl = s.nl, &nr = s.nr;
-    lo.resize(n);
-    hi.resize(n);
+    grow_buffer(lo, n);
+    grow_buffer(hi, n);
     d.clear();
     nl.clear();
     nr.clear();
@@ -679,14 +679,14 @@ class BspBuilder {
     }
     if (!(range_hi > range_lo)) return;
     if (n <= size_t(config_.bins)) {
-      exact_candidates(lo, hi, n, d, nl, nr);
+      exact_candidates(lo.data(), hi.data(), n, n, d, nl, nr);
     } else {
-      binned_candidates(lo, hi, range_lo, range_hi, s, d, nl, nr);
+      binned_candidates(lo.data(), hi.data(), n, range_lo, range_hi, s, d, nl, nr);
     }
     // A large node (axes only) also tries the extent planes of the triangles the autopartition would
     // take: at a fan's centre every triangle ends at the shared vertex, and only a plane through it
     // separates them (without it, 20k `fan`'s centre stayed one leaf of 20,000).
-    if (large_node(n)) exact_candidates(lo, hi, size_t(config_.autopartition), d, nl, nr);
+    if (large_node(n)) exact_candidates(lo.data(), hi.data(), n, size_t(config_.autopartition), d, nl, nr);
     float cell_lo, cell_hi;
     surface.extent(dir, cell_lo, cell_hi);
     const float min_gap = (cell_hi - cell_lo) / float(config_.bins);
@@ -698,8 +698,8 @@ class BspBuilder {
       nl[m] = nl[j];
       nr[m++] = nr[j];
     }
-    al.resize(m);
-    ar.resize(m);
+    grow_buffer(al, m);
+    grow_buffer(ar, m);
     surface.areas(dir, std::span<const float>(d.data(), m), al.data(), ar.data());
     for (size_t j = 0; j < m; ++j)
       keep(ch, BspPlane{dir, d[j]}, cell_area, al[j], ar[j], nl[j], nr[j], n, shave_ok);
@@ -707,9 +707,9 @@ class BspBuilder {
 
   /// Planes at the start and end of the extents of `samples` primitives spread over the node (every one
   /// when samples >= n; that primitive on one side only), appended with exact counts.
-  void exact_candidates(const std::vector<float>& lo, const std::vector<float>& hi, size_t samples,
-                        std::vector<float>& d, std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
-    const size_t n = lo.size(), k = std::min(n, samples), first = d.size();
+  void exact_candidates(const float* lo, const float* hi, size_t n, size_t samples, std::vector<float>& d,
+                        std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
+    const size_t k = std::min(n, samples), first = d.size();
     for (size_t j = 0; j < k; ++j) {
       d.push_back(lo[j * n / k]);  // primitive j above only (side_bits)
       d.push_back(hi[j * n / k]);  // primitive j below only
@@ -739,10 +739,9 @@ class BspBuilder {
   static constexpr size_t kCountLanes = 16;
 
   /// The bin boundaries and the planes two margins outside the whole range, with binned counts.
-  void binned_candidates(const std::vector<float>& lo, const std::vector<float>& hi, float range_lo,
-                         float range_hi, PlaneScratch& s, std::vector<float>& d, std::vector<uint32_t>& nl,
+  void binned_candidates(const float* lo, const float* hi, size_t n, float range_lo, float range_hi,
+                         PlaneScratch& s, std::vector<float>& d, std::vector<uint32_t>& nl,
                          std::vector<uint32_t>& nr) const {
-    const size_t n = lo.size();
     const int bins = config_.bins;
     std::vector<uint32_t>&starts = s.starts, &ends = s.ends;
     starts.assign(size_t(bins), 0);
@@ -780,8 +779,8 @@ class BspBuilder {
   void classify(const NodePrims& np, const BspPlane& plane, std::vector<uint8_t>& sides, size_t& nl,
                 size_t& nr) const {
     thread_local std::vector<float> dots, lo, hi;  // used only here: no call below builds a node
-    lo.resize(np.size());
-    hi.resize(np.size());
+    grow_buffer(lo, np.size());
+    grow_buffer(hi, np.size());
     ranges(np, plane.n, dots, lo.data(), hi.data());
     sides.resize(np.size());
     for (size_t k = 0; k < np.size(); ++k) {

@@ -16,6 +16,13 @@
 
 namespace ab {
 
+/// Makes kept buffer v at least n long; it never shrinks, so once grown the call does nothing (its users
+/// index it, never read its size).
+template <class T>
+inline void grow_buffer(std::vector<T>& v, size_t n) {
+  if (v.size() < n) v.resize(n);
+}
+
 /// A convex polyhedron given by its faces (each a convex polygon, counter-clockwise seen from outside), kept
 /// in one flat array of vertices with each face's first index (two allocations per cell, not one per face).
 class ConvexCell {
@@ -111,8 +118,8 @@ class ConvexCell {
   /// The parts of part() on the sides in `which` (the others left empty).
   std::pair<ConvexCell, ConvexCell> parts(const BspPlane& p, int which) const {
     thread_local std::vector<float> dist, tol;
-    dist.resize(verts_.size());
-    tol.resize(verts_.size());
+    grow_buffer(dist, verts_.size());
+    grow_buffer(tol, verts_.size());
     bool pos = false, neg = false;  // some vertex clearly above, clearly below
     for (size_t i = 0; i < verts_.size(); ++i) {
       dist[i] = p.distance(verts_[i]);
@@ -355,7 +362,7 @@ class CellSurface {
         cutting.push_back(uint32_t(k));
       }
     }
-    lanes_.resize(2 * kLanes * cutting.size());
+    grow_buffer(lanes_, 2 * kLanes * cutting.size());
     for (size_t q = 0; q < cutting.size(); ++q) area_below(d[cutting[q]], &lanes_[2 * kLanes * q]);
     for (size_t q = 0; q < cutting.size(); ++q) {  // the planes' lane sums are independent: they overlap
       const float* l = &lanes_[2 * kLanes * q];
@@ -428,7 +435,7 @@ class CellSurface {
     std::array<float, kLanes> lo, hi;
     lo.fill(kInf);
     hi.fill(-kInf);
-    block_low_.resize(padded / kLanes);
+    grow_buffer(block_low_, padded / kLanes);
     for (size_t i = 0; i < padded; i += kLanes) {
       float block = kInf;
       for (size_t l = 0; l < kLanes; ++l) {
