@@ -476,8 +476,15 @@ class BspBuilder {
   }
 
   /// Writes build_top's node i and its subtree into out in build_node's order.
-  static void lay_out(const std::vector<TopNode>& t, uint32_t i, BspBuffer& out) {
-    if (!t[i].split) return out.append(t[i].sub);
+  static void lay_out(std::vector<TopNode>& t, uint32_t i, BspBuffer& out) {
+    // A root the top left to the depth-first build (a 10M input's) is its buffer, moved, not copied.
+    if (!t[i].split) {
+      if (out.nodes.empty() && out.refs.empty() && out.payload.empty())
+        out = std::move(t[i].sub);
+      else
+        out.append(t[i].sub);
+      return;
+    }
     write_interior(
         out, t[i].plane, [&](BspBuffer& o) { lay_out(t, t[i].below, o); },
         [&](BspBuffer& o) { lay_out(t, t[i].above, o); });
