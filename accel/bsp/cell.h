@@ -316,7 +316,9 @@ class CellSurface {
     count_ = 0;
     total_ = 0.0f;
     tol_ = 0.0f;
-    for (auto& f : in_) f.clear();
+    size_t most = 0;  // the triangles of the fans, before those of no area are left out
+    for (size_t k = 0; k < cell.face_count(); ++k) most += std::max<size_t>(cell.face(k).size(), 2) - 2;
+    for (auto& f : in_) grow_buffer(f, most);  // written by index (add), up to count_
     for (size_t k = 0; k < cell.face_count(); ++k) {
       const std::span<const vec3> f = cell.face(k);
       for (size_t i = 2; i < f.size(); ++i) add(f[0], f[i - 1], f[i]);
@@ -330,7 +332,8 @@ class CellSurface {
       heights_[i] = kInf;
       heights_[2 * padded_ + i] = -kInf;
     }
-    std::copy(in_[kArea].begin(), in_[kArea].end(), heights_.begin() + ptrdiff_t(5 * padded_));
+    std::copy(in_[kArea].begin(), in_[kArea].begin() + ptrdiff_t(count_),
+              heights_.begin() + ptrdiff_t(5 * padded_));
     prepared_ = false;
   }
 
@@ -349,8 +352,9 @@ class CellSurface {
   void areas(const vec3& n, std::span<const float> d, float* below, float* above) const {
     prepare(n);
     // The planes that cut the cell, the others within rounding of its extent (no cut, as part).
-    thread_local std::vector<uint32_t> cutting;
-    cutting.clear();
+    thread_local std::vector<uint32_t> cutting;  // the first `count`, written by index (no push_back call)
+    grow_buffer(cutting, d.size());
+    size_t count = 0;
     for (size_t k = 0; k < d.size(); ++k) {
       if (!(d[k] > lowest_ + tol_)) {
         below[k] = 0.0f;
@@ -359,12 +363,12 @@ class CellSurface {
         below[k] = total_;
         above[k] = 0.0f;
       } else {
-        cutting.push_back(uint32_t(k));
+        cutting[count++] = uint32_t(k);
       }
     }
-    grow_buffer(lanes_, 2 * kLanes * cutting.size());
-    for (size_t q = 0; q < cutting.size(); ++q) area_below(d[cutting[q]], &lanes_[2 * kLanes * q]);
-    for (size_t q = 0; q < cutting.size(); ++q) {  // the planes' lane sums are independent: they overlap
+    grow_buffer(lanes_, 2 * kLanes * count);
+    for (size_t q = 0; q < count; ++q) area_below(d[cutting[q]], &lanes_[2 * kLanes * q]);
+    for (size_t q = 0; q < count; ++q) {  // the planes' lane sums are independent: they overlap
       const float* l = &lanes_[2 * kLanes * q];
       float sb = 0.0f, sc = 0.0f;
       for (size_t j = 0; j < kLanes; ++j) {
@@ -390,7 +394,7 @@ class CellSurface {
     const vec3 nrm = cr / twice;
     const float v[kInFields] = {a.x, a.y, a.z,          b.x,   b.y,   b.z,  c.x,
                                 c.y, c.z, 0.5f * twice, nrm.x, nrm.y, nrm.z};
-    for (size_t f = 0; f < kInFields; ++f) in_[f].push_back(v[f]);
+    for (size_t f = 0; f < kInFields; ++f) in_[f][count_] = v[f];
     total_ += 0.5f * twice;
     ++count_;
   }
