@@ -439,7 +439,7 @@ class BspBuilder {
       TopNode& x = t[level[k]];
       build_node(std::move(x.np), x.cell, x.depth, kNoMemo, x.sub);
     });
-    lay_out(t, 0, out);
+    lay_out(t, out);
   }
 
   /// The next level of build_top: the children of the level's nodes that split (in parallel, appended in
@@ -475,19 +475,53 @@ class BspBuilder {
     return next;
   }
 
-  /// Writes build_top's node i and its subtree into out in build_node's order.
-  static void lay_out(std::vector<TopNode>& t, uint32_t i, BspBuffer& out) {
-    // A root the top left to the depth-first build (a 10M input's) is its buffer, moved, not copied.
-    if (!t[i].split) {
-      if (out.nodes.empty() && out.refs.empty() && out.payload.empty())
-        out = std::move(t[i].sub);
-      else
-        out.append(t[i].sub);
+  /// Where a node of build_top's tree and its subtree go in the output: its first node, reference and plane.
+  struct TopPlace {
+    size_t node = 0, ref = 0, payload = 0;
+  };
+
+  /// Places node i's subtree from `at` on in build_node's order (a split node: itself and its plane, its
+  /// below subtree, its above one) into places; returns the place after it.
+  static TopPlace place(const std::vector<TopNode>& t, uint32_t i, TopPlace at,
+                        std::vector<TopPlace>& places) {
+    places[i] = at;
+    const BspBuffer& s = t[i].sub;
+    if (!t[i].split) return {at.node + s.nodes.size(), at.ref + s.refs.size(), at.payload + s.payload.size()};
+    at = place(t, t[i].below, {at.node + 1, at.ref, at.payload + 1}, places);
+    return place(t, t[i].above, at, places);
+  }
+
+  /// Writes build_top's tree into the empty out in build_node's order: every node's place first (serial,
+  /// over the top's nodes only), then each node's part in parallel, a subtree rebased into its place as
+  /// TreeBuffer::append would (appended one after another, the whole tree was copied on one core). A root
+  /// the top left to the depth-first build (a 10M input's, when the top stops at once) is moved.
+  static void lay_out(std::vector<TopNode>& t, BspBuffer& out) {
+    if (!t[0].split) {
+      out = std::move(t[0].sub);
       return;
     }
-    write_interior(
-        out, t[i].plane, [&](BspBuffer& o) { lay_out(t, t[i].below, o); },
-        [&](BspBuffer& o) { lay_out(t, t[i].above, o); });
+    std::vector<TopPlace> places(t.size());
+    const TopPlace end = place(t, 0, TopPlace{}, places);
+    out.nodes.assign(end.node, BspNode::leaf(0, 0));
+    out.refs.resize(end.ref);
+    out.payload.resize(end.payload);
+    tbb::parallel_for(size_t(0), t.size(), [&](size_t i) {
+      const TopPlace& at = places[i];
+      if (t[i].split) {
+        out.payload[at.payload] = t[i].plane;
+        out.nodes[at.node] = BspNode::interior(uint32_t(at.payload), uint32_t(places[t[i].above].node));
+        return;
+      }
+      const BspBuffer& s = t[i].sub;
+      const TreeOffsets offsets{uint32_t(at.node), uint32_t(at.ref), uint32_t(at.payload)};
+      for (size_t j = 0; j < s.nodes.size(); ++j) {
+        BspNode n = s.nodes[j];
+        n.rebase(offsets);
+        out.nodes[at.node + j] = n;
+      }
+      std::copy(s.refs.begin(), s.refs.end(), out.refs.begin() + ptrdiff_t(at.ref));
+      std::copy(s.payload.begin(), s.payload.end(), out.payload.begin() + ptrdiff_t(at.payload));
+    });
   }
 
   /// The signed-distance ranges [lo[k], hi[k]] of every primitive's support points from the plane through
