@@ -838,10 +838,12 @@ class BspBuilder {
   /// Nodes of at least kParallelPrims primitives clip them and measure their ranges in parallel, in chunks
   /// of about kParallelGrain (collect, ranges).
   static constexpr size_t kParallelPrims = size_t(1) << 16, kParallelGrain = size_t(1) << 14;
-  /// build_top's levels hold at most this many references (about 600 MB of clipped parts), so a 10M input's
-  /// root goes straight to the depth-first build; more than the 200k hostile inputs' budget (6.4M), so a
-  /// tree over it is abandoned in the breadth-first top.
-  static constexpr size_t kTopRefs = size_t(1) << 23;
+  /// build_top's levels hold at most this many references (about 1.6 GB of clipped parts); more than the
+  /// 200k hostile inputs' budget (6.4M), so a tree over it is abandoned in the breadth-first top. 2^25
+  /// (2^23 until issue 11's twelfth step, when a 10M input's root went straight to the depth-first build:
+  /// its top levels' nodes then ran one or two at a time, and every parallel node copied its above subtree
+  /// into its parent's buffer; breadth first, a 10M ordinary input's levels hold 10-12M references).
+  static constexpr size_t kTopRefs = size_t(1) << 25;
   /// build_top's levels hold at most kTopNodes nodes, or kTopNodesMax (and N) while each level holds more
   /// than kTopGrowth times the references of the one before: a tree over the budget passes it within its
   /// duplicating levels, and any other tree goes on depth first, with little memory (the same tree either
