@@ -6,8 +6,9 @@
 // bad refines, limited per path; kdtree-sah's max_leaf split of a large node the SAH would keep; the
 // reference budget (build_with_budget, refine_rules.h) as the safety net of the references, at most
 // ref_budget per primitive, the tree unchanged on any input whose tree stays under it. Large nodes build
-// their two subtrees in parallel, each into its own buffer, appended in a fixed order (the same tree for
-// any thread count).
+// their two subtrees in parallel, the below one into the parent's buffer and the above one into its own,
+// appended after it (the same tree for any thread count); nodes of many primitives also clip them and
+// measure their ranges in parallel.
 #pragma once
 
 #include <tbb/blocked_range.h>
