@@ -14,11 +14,13 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <span>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "accel/bsp/candidates.h"
@@ -121,8 +123,16 @@ class BspBuilder {
       fill(0);
       return std::move(pieces[0]);
     }
-    tbb::parallel_for(size_t(0), chunks, fill);
+    isolated([&] { tbb::parallel_for(size_t(0), chunks, fill); });
     return join(pieces);
+  }
+
+  /// Runs f, whose parallel loop is one node's work, isolated (tbb::this_task_arena::isolate): a thread
+  /// waiting for the loop's chunks runs none of another node's tasks, which would overwrite the kept
+  /// (thread_local) buffers the caller is still using (classify's ranges, find_plane's surface).
+  template <class F>
+  static void isolated(F&& f) {
+    tbb::this_task_arena::isolate(std::forward<F>(f));
   }
 
   /// The pieces' primitives one after another (collect), copied in parallel.
@@ -136,12 +146,14 @@ class BspBuilder {
     out.ids.resize(ids_at.back());
     out.start.resize(ids_at.back() + 1);
     out.pts.resize(pts_at.back());
-    tbb::parallel_for(size_t(0), pieces.size(), [&](size_t c) {
-      const NodePrims& p = pieces[c];
-      std::copy(p.ids.begin(), p.ids.end(), out.ids.begin() + ptrdiff_t(ids_at[c]));
-      std::copy(p.pts.begin(), p.pts.end(), out.pts.begin() + ptrdiff_t(pts_at[c]));
-      for (size_t k = 0; k < p.size(); ++k)
-        out.start[ids_at[c] + k + 1] = uint32_t(pts_at[c] + p.start[k + 1]);
+    isolated([&] {
+      tbb::parallel_for(size_t(0), pieces.size(), [&](size_t c) {
+        const NodePrims& p = pieces[c];
+        std::copy(p.ids.begin(), p.ids.end(), out.ids.begin() + ptrdiff_t(ids_at[c]));
+        std::copy(p.pts.begin(), p.pts.end(), out.pts.begin() + ptrdiff_t(pts_at[c]));
+        for (size_t k = 0; k < p.size(); ++k)
+          out.start[ids_at[c] + k + 1] = uint32_t(pts_at[c] + p.start[k + 1]);
+      });
     });
     return out;
   }
@@ -530,18 +542,20 @@ class BspBuilder {
   /// extremes (from a plane at offset d the ranges are these less d: subtracting d keeps the order).
   static void ranges(const NodePrims& np, const vec3& n, std::vector<float>& dots, float* lo, float* hi) {
     if (np.size() >= kParallelPrims) {  // a large node's in parallel, each point's distance as below
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, np.size(), kParallelGrain), [&](const auto& r) {
-        for (size_t k = r.begin(); k < r.end(); ++k) {
-          float a = kInf, b = -kInf;
-          for (uint32_t j = np.start[k]; j < np.start[k + 1]; ++j) {
-            const vec3& p = np.pts[j];
-            const float t = n.x * p.x + n.y * p.y + n.z * p.z;
-            a = std::min(a, t);
-            b = std::max(b, t);
+      isolated([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, np.size(), kParallelGrain), [&](const auto& r) {
+          for (size_t k = r.begin(); k < r.end(); ++k) {
+            float a = kInf, b = -kInf;
+            for (uint32_t j = np.start[k]; j < np.start[k + 1]; ++j) {
+              const vec3& p = np.pts[j];
+              const float t = n.x * p.x + n.y * p.y + n.z * p.z;
+              a = std::min(a, t);
+              b = std::max(b, t);
+            }
+            lo[k] = a;
+            hi[k] = b;
           }
-          lo[k] = a;
-          hi[k] = b;
-        }
+        });
       });
       return;
     }
