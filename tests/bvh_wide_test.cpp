@@ -7,9 +7,11 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <random>
 
 #include "accel/bvh/bvh.h"
+#include "accel/bvh/leaf_fill.h"
 #include "accel/bvh/walk8.h"
 #include "accel/core/box_test.h"
 #include "accel/core/triangle4.h"
@@ -25,6 +27,19 @@ using testing::uniform;
 
 std::shared_ptr<const TrianglePrims> prims_of(const Mesh& m) {
   return std::make_shared<const TrianglePrims>(std::make_shared<const Mesh>(m));
+}
+
+/// Lane k of node holds no child (an empty box).
+void set_empty_lane(Bvh8Node& node, int k) {
+  for (int a = 0; a < 3; ++a) node.bounds[a][k] = kInf, node.bounds[3 + a][k] = -kInf;
+  node.child[k] = node.count[k] = 0;
+}
+
+/// Lane k of node holds the leaf [first, first + n) of the order in box.
+void set_leaf_lane(Bvh8Node& node, int k, const AABB& box, uint32_t first, uint32_t n) {
+  for (int a = 0; a < 3; ++a) node.bounds[a][k] = box.lo[a], node.bounds[3 + a][k] = box.hi[a];
+  node.child[k] = first;
+  node.count[k] = n;
 }
 
 uint32_t bits(float f) {
@@ -226,6 +241,8 @@ TEST(Bvh8, CollapsedTreeInvariants) {
     }
     EXPECT_GE(used, i == 0 ? 1 : 2);
     lanes += uint64_t(used);
+    for (int k = 0; k < 8 && used < 8; ++k)  // free lanes took the leaves of two blocks (leaf_fill.h)
+      EXPECT_TRUE(wide[i].count[k] <= 4 || wide[i].count[k] > 8) << "node " << i << " lane " << k;
   }
   EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
   EXPECT_EQ(bvh.stats().leaves, leaves);
@@ -233,6 +250,50 @@ TEST(Bvh8, CollapsedTreeInvariants) {
   EXPECT_EQ(bvh.stats().references, mesh.size());
   EXPECT_GT(double(lanes) / double(wide.size()), 3.0);  // the collapse fills nodes
   EXPECT_LT(bvh.stats().max_depth, bvh.stats().extra["binary_max_depth"].get<uint32_t>());
+}
+
+/// fill_free_lanes on one node: a leaf of n (5 to 8) triangles beside a free lane becomes two leaves of at
+/// most four whose boxes hold their triangles' parts in the old box and lie inside it; a full node and
+/// leaves of one block stay as they are.
+TEST(Bvh8, FreeLanesTakeTheTwoBlockLeaves) {
+  const Mesh mesh = random_soup(64, 5);
+  const auto prims = prims_of(mesh);
+  std::vector<uint32_t> order(mesh.size());
+  std::iota(order.begin(), order.end(), 0u);
+  for (uint32_t n = 5; n <= 8; ++n) {
+    Bvh8Node node{};
+    for (int k = 0; k < 8; ++k) set_empty_lane(node, k);
+    AABB leaf;  // the centres' box: every triangle has a part inside, as in a spatial-split leaf
+    for (uint32_t j = 0; j < n; ++j) leaf.extend(mesh.triangle(j).bounds().center());
+    set_leaf_lane(node, 0, leaf, 0, n);
+    set_leaf_lane(node, 1, mesh.triangle(10).bounds(), 10, 3);
+    NodeLaneIds ids;
+    fill_free_lanes(node, order, *prims, ids);
+    ASSERT_EQ(node.count[1], 3u);
+    ASSERT_EQ(ids.lane[1], order.data() + 10);
+    ASSERT_TRUE(node.used(2));
+    EXPECT_EQ(node.count[0] + node.count[2], n);
+    EXPECT_LE(node.count[0], 4u);
+    EXPECT_LE(node.count[2], 4u);
+    EXPECT_FALSE(node.used(3));
+    std::vector<uint32_t> got;
+    for (int k : {0, 2}) {
+      const AABB box = node.box(k);
+      EXPECT_TRUE(leaf.contains(box.lo) && leaf.contains(box.hi));
+      for (uint32_t j = 0; j < node.count[k]; ++j) {
+        got.push_back(ids.lane[k][j]);
+        const AABB part = AABB::intersection(mesh.triangle(ids.lane[k][j]).bounds(), leaf);
+        EXPECT_TRUE(box.contains(part.lo) && box.contains(part.hi));
+      }
+    }
+    std::sort(got.begin(), got.end());
+    for (uint32_t j = 0; j < n; ++j) EXPECT_EQ(got[j], j);
+  }
+  Bvh8Node full{};
+  for (int k = 0; k < 8; ++k) set_leaf_lane(full, k, mesh.triangle(k).bounds(), 8 * k, 6);
+  NodeLaneIds ids;
+  fill_free_lanes(full, order, *prims, ids);
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(full.count[k], 6u);
 }
 
 TEST(Bvh8, WidthIsTwoOrEight) {

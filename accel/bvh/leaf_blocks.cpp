@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "accel/bvh/huge_pages.h"
+#include "accel/bvh/leaf_fill.h"
 
 namespace ab {
 
@@ -19,19 +20,23 @@ uint32_t blocks_of(uint32_t n) {
   return (n + 3) / 4;
 }
 
-/// Packs the leaves of one node into the blocks from `first` on (and their ids), rewriting the lanes.
+/// Packs the leaves of one node into the blocks from `first` on (and their ids), rewriting the lanes; leaves
+/// of two blocks first fill the node's free lanes (fill_free_lanes), which takes as many blocks.
 void pack_node(Bvh8Node& node, uint32_t first, std::span<const uint32_t> order, const TrianglePrims& prims,
                Bvh8LeafBlocks& out) {
+  NodeLaneIds lanes;
+  fill_free_lanes(node, order, prims, lanes);
   for (int k = 0; k < Bvh8Node::kWidth; ++k) {
     if (node.count[k] == 0) continue;
-    const uint32_t begin = node.child[k], n = node.count[k];
+    const uint32_t* ids = lanes.lane[k];
+    const uint32_t n = node.count[k];
     node.child[k] = first;
     for (uint32_t s = 0; s < n; s += 4, ++first) {
       Triangle quad[4] = {};  // only the first m are read; zeroed so no lane is uninitialized
       const uint32_t m = std::min(4u, n - s);
       for (uint32_t j = 0; j < 4; ++j) {
-        if (j < m) quad[j] = prims.triangle(order[begin + s + j]);
-        out.ids[4 * size_t(first) + j] = j < m ? order[begin + s + j] : kInvalidId;
+        if (j < m) quad[j] = prims.triangle(ids[s + j]);
+        out.ids[4 * size_t(first) + j] = j < m ? ids[s + j] : kInvalidId;
       }
       out.blocks[first] = Triangle4::pack(std::span<const Triangle>(quad, m));
     }
