@@ -90,15 +90,55 @@ struct BinIndexer {
   }
 };
 
-/// The bins of one node on the three axes (axis a, bin k at a * nb + k), reducible in parallel.
+/// A box as one 256-bit vector, lo in the low half and -hi in the high half, so that one minimum extends
+/// both bounds (Wald 2007's bin update in half the instructions; the negation is exact, so the bounds are
+/// the same bits as a Box4's). The empty box is +inf in every lane. Stored unaligned (float[8]): a BinSet
+/// may live in a TBB body, whose storage is not promised 32-byte alignment.
+struct NegBox8 {
+  float v[8];
+
+  /// The empty box.
+  static NegBox8 empty() {
+    NegBox8 b;
+    _mm256_storeu_ps(b.v, _mm256_set1_ps(kInf));
+    return b;
+  }
+  /// The box of a reference: its lo (id lane zeroed) and its negated hi.
+  static __m256 of(const BinRef& ref) {
+    const __m256 keep = _mm256_castsi256_ps(_mm256_setr_epi32(-1, -1, -1, 0, -1, -1, -1, -1));
+    const __m256 sign = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, -0.0f, -0.0f, -0.0f, -0.0f);
+    return _mm256_xor_ps(_mm256_and_ps(_mm256_load_ps(ref.lo), keep), sign);
+  }
+  /// The centre of a box in this form: (lo - (-hi)) * 0.5, the same bits as BinRef::center() (subtracting
+  /// a negated value is adding it, exactly).
+  static __m128 center(__m256 x) {
+    return _mm_mul_ps(_mm_sub_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1)), _mm_set1_ps(0.5f));
+  }
+  __m256 get() const { return _mm256_loadu_ps(v); }
+  void extend(__m256 b) { _mm256_storeu_ps(v, _mm256_min_ps(get(), b)); }
+  void extend(const NegBox8& b) { extend(b.get()); }
+  /// The same box as two vectors (lane 3: 0 and 0, or +inf and -inf when empty, as a Box4's).
+  Box4 box4() const { return box4(get()); }
+  /// The Box4 of a box in this form.
+  static Box4 box4(__m256 x) {
+    const __m128 hi = _mm_xor_ps(_mm256_extractf128_ps(x, 1), _mm_set1_ps(-0.0f));
+    return {_mm256_castps256_ps128(x), hi};
+  }
+};
+
+/// The bins of one node on the three axes, reducible in parallel: the box of axis a, bin k at a * nb + k,
+/// its count at 4 k + a (the three axes' counts of a bin are one vector for the sweep).
 struct BinSet {
   int nb;
-  std::array<Box4, 3 * kMaxBins> box;
-  std::array<uint32_t, 3 * kMaxBins> count;
+  std::array<NegBox8, 3 * kMaxBins> box;
+  alignas(16) std::array<uint32_t, 4 * kMaxBins> count;
 
   explicit BinSet(int bins) : nb(bins) {
-    for (int k = 0; k < 3 * nb; ++k) box[k] = Box4::empty(), count[k] = 0;
+    for (int k = 0; k < 3 * nb; ++k) box[k] = NegBox8::empty();
+    for (int k = 0; k < 4 * nb; ++k) count[k] = 0;
   }
+  /// The counts of bin k on the three axes (lane 3: 0).
+  __m128i counts(int k) const { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(&count[4 * k])); }
   /// Adds refs [b, e). A long range is binned into this set and a second one alternately and merged at
   /// the end: consecutive references often fall into the same bins, and with one set each would wait for
   /// the previous one's box update (a store-to-load chain). The sums and bounds are exact, so the bins are
@@ -119,7 +159,8 @@ struct BinSet {
   }
   /// Adds the bins of o (exact: min, max and integer sums).
   void merge(const BinSet& o) {
-    for (int k = 0; k < 3 * nb; ++k) box[k].extend(o.box[k]), count[k] += o.count[k];
+    for (int k = 0; k < 3 * nb; ++k) box[k].extend(o.box[k]);
+    for (int k = 0; k < 4 * nb; ++k) count[k] += o.count[k];
   }
 
  private:
@@ -128,13 +169,12 @@ struct BinSet {
 
   /// Adds the reference to its bin on each axis.
   void put(const BinRef& ref, const BinIndexer& ix) {
-    const __m128 lo = ref.lo4(), hi = ref.hi4();
+    const __m256 b = NegBox8::of(ref);
     alignas(16) int32_t bin[4];
-    _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(ref.center()));
+    _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(NegBox8::center(b)));
     for (int a = 0; a < 3; ++a) {
-      const int j = a * nb + bin[a];
-      box[j].extend(lo, hi);
-      ++count[j];
+      box[a * nb + bin[a]].extend(b);
+      ++count[4 * bin[a] + a];
     }
   }
 };
@@ -158,30 +198,33 @@ inline __m128 areas3(const Box4* box) {
 inline SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_area,
                                       const SahCosts& costs) {
   const int n = bins.nb;
-  auto counts = [&](int k) {
-    return _mm_setr_epi32(int(bins.count[k]), int(bins.count[n + k]), int(bins.count[2 * n + k]), 0);
+  auto counts = [&](int k) { return bins.counts(k); };
+  auto extend = [&](__m256* acc, int k) {
+    for (int a = 0; a < 3; ++a) acc[a] = _mm256_min_ps(acc[a], bins.box[a * n + k].get());
   };
-  auto extend = [&](Box4* acc, int k) {
-    for (int a = 0; a < 3; ++a) acc[a].extend(bins.box[a * n + k]);
+  auto areas = [](const __m256* acc) {
+    const Box4 b[3] = {NegBox8::box4(acc[0]), NegBox8::box4(acc[1]), NegBox8::box4(acc[2])};
+    return areas3(b);
   };
+  const __m256 empty = _mm256_set1_ps(kInf);
   __m128 right_area[kMaxBins];  // only [1, n) is written and read
   __m128i right_count[kMaxBins];
-  Box4 acc[3] = {Box4::empty(), Box4::empty(), Box4::empty()};
+  __m256 acc[3] = {empty, empty, empty};
   __m128i cnt = _mm_setzero_si128();
   for (int i = n - 1; i > 0; --i) {
     extend(acc, i);
     cnt = _mm_add_epi32(cnt, counts(i));
-    right_area[i] = areas3(acc);
+    right_area[i] = areas(acc);
     right_count[i] = cnt;
   }
-  acc[0] = acc[1] = acc[2] = Box4::empty();
+  acc[0] = acc[1] = acc[2] = empty;
   cnt = _mm_setzero_si128();
   __m128 best_w = _mm_set1_ps(kInf), best_la = _mm_setzero_ps(), best_ra = _mm_setzero_ps();
   __m128i best_i = _mm_setzero_si128(), best_lc = _mm_setzero_si128();
   for (int i = 1; i < n; ++i) {
     extend(acc, i - 1);
     cnt = _mm_add_epi32(cnt, counts(i - 1));
-    const __m128 la = areas3(acc), ra = right_area[i];
+    const __m128 la = areas(acc), ra = right_area[i];
     const __m128 w =
         _mm_add_ps(_mm_mul_ps(la, _mm_cvtepi32_ps(cnt)), _mm_mul_ps(ra, _mm_cvtepi32_ps(right_count[i])));
     const __m128i empty_side = _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()),
@@ -265,8 +308,8 @@ inline BinnedSplit find_binned_split(const BinRef* refs, uint32_t b, uint32_t e,
     if (out.sah.axis < 0) return;
     const int base = out.sah.axis * bins.nb;
     for (int k = 0; k < bins.nb; ++k) {
-      (k < out.sah.position ? out.left : out.right).extend(bins.box[base + k]);
-      if (k < out.sah.position) out.left_count += bins.count[base + k];
+      (k < out.sah.position ? out.left : out.right).extend(bins.box[base + k].box4());
+      if (k < out.sah.position) out.left_count += bins.count[4 * k + out.sah.axis];
     }
   };
   if (e - b < kParallelReduceThreshold) {
