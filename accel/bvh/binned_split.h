@@ -179,52 +179,65 @@ struct BinSet {
   }
 };
 
-/// Areas of three boxes at once (lane a: box a), each bit for bit AABB::area() (same products, same order).
-inline __m128 areas3(const Box4* box) {
-  __m128 x = _mm_max_ps(_mm_sub_ps(box[0].hi, box[0].lo), _mm_setzero_ps());
-  __m128 y = _mm_max_ps(_mm_sub_ps(box[1].hi, box[1].lo), _mm_setzero_ps());
-  __m128 z = _mm_max_ps(_mm_sub_ps(box[2].hi, box[2].lo), _mm_setzero_ps());
-  __m128 w = _mm_setzero_ps();
-  _MM_TRANSPOSE4_PS(x, y, z, w);  // now x, y, z hold the extents along x, y, z of the three boxes
-  const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
-  return _mm_mul_ps(_mm_set1_ps(2.0f), s);
+/// The areas of three boxes at once, lane a of each half for box a, for two triples of boxes in the
+/// (lo, -hi) form: the left ones in the low half of the result, the right ones in the high half. Each area
+/// is bit for bit AABB::area() (its products, in its order): the extent hi - lo is computed as
+/// -((-hi) + lo), which rounds to the same value (round to nearest is symmetric; a zero extent becomes -0,
+/// which the clamp at 0 turns into +0 as before).
+inline __m256 areas3_pair(const __m256* left, const __m256* right) {
+  const __m256 sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
+  __m256 d[3];
+  for (int a = 0; a < 3; ++a) {
+    const __m256 lo = _mm256_permute2f128_ps(left[a], right[a], 0x20);
+    const __m256 neg_hi = _mm256_permute2f128_ps(left[a], right[a], 0x31);
+    d[a] = _mm256_max_ps(_mm256_xor_ps(_mm256_add_ps(neg_hi, lo), sign), zero);
+  }
+  // The transpose of _MM_TRANSPOSE4_PS (rows d[0], d[1], d[2], 0) in both halves at once; the fourth row
+  // is not needed.
+  const __m256 t0 = _mm256_unpacklo_ps(d[0], d[1]), t1 = _mm256_unpacklo_ps(d[2], zero);
+  const __m256 t2 = _mm256_unpackhi_ps(d[0], d[1]), t3 = _mm256_unpackhi_ps(d[2], zero);
+  const __m256 x = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0));
+  const __m256 y = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2));
+  const __m256 z = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
+  const __m256 s =
+      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, y), _mm256_mul_ps(y, z)), _mm256_mul_ps(z, x));
+  return _mm256_mul_ps(_mm256_set1_ps(2.0f), s);
 }
 
-/// The cheapest bin boundary over the three axes, one axis per vector lane (Wald 2007): suffix areas right to
-/// left, then prefix areas left to right. Within an axis a boundary is ranked by left_area * left_count +
-/// right_area * right_count (the cost without its constant terms, so no division per boundary); the first
-/// cheapest boundary of each axis is priced with SahCosts::split, and the first cheapest axis wins. Axes
-/// whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
+/// The cheapest bin boundary over the three axes, one axis per vector lane (Wald 2007): one pass
+/// accumulates the prefix boxes from the left and the suffix boxes from the right together (their areas
+/// computed two triples at a time), a second ranks the boundaries left to right. Within an axis a boundary
+/// is ranked by left_area * left_count + right_area * right_count (the cost without its constant terms, so
+/// no division per boundary); the first cheapest boundary of each axis is priced with SahCosts::split, and
+/// the first cheapest axis wins. Axes whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
 inline SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_area,
                                       const SahCosts& costs) {
   const int n = bins.nb;
-  auto counts = [&](int k) { return bins.counts(k); };
   auto extend = [&](__m256* acc, int k) {
     for (int a = 0; a < 3; ++a) acc[a] = _mm256_min_ps(acc[a], bins.box[a * n + k].get());
   };
-  auto areas = [](const __m256* acc) {
-    const Box4 b[3] = {NegBox8::box4(acc[0]), NegBox8::box4(acc[1]), NegBox8::box4(acc[2])};
-    return areas3(b);
-  };
   const __m256 empty = _mm256_set1_ps(kInf);
-  __m128 right_area[kMaxBins];  // only [1, n) is written and read
-  __m128i right_count[kMaxBins];
-  __m256 acc[3] = {empty, empty, empty};
-  __m128i cnt = _mm_setzero_si128();
-  for (int i = n - 1; i > 0; --i) {
-    extend(acc, i);
-    cnt = _mm_add_epi32(cnt, counts(i));
-    right_area[i] = areas(acc);
-    right_count[i] = cnt;
+  // Boundary i (1 <= i < n) puts bins [0, i) left and [i, n) right; only [1, n) is written and read.
+  __m128 left_area[kMaxBins], right_area[kMaxBins];
+  __m128i left_count[kMaxBins], right_count[kMaxBins];
+  __m256 left[3] = {empty, empty, empty}, right[3] = {empty, empty, empty};
+  __m128i lc = _mm_setzero_si128(), rc = _mm_setzero_si128();
+  for (int i = 1; i < n; ++i) {
+    extend(left, i - 1);
+    extend(right, n - i);
+    lc = _mm_add_epi32(lc, bins.counts(i - 1));
+    rc = _mm_add_epi32(rc, bins.counts(n - i));
+    const __m256 areas = areas3_pair(left, right);
+    left_area[i] = _mm256_castps256_ps128(areas);
+    right_area[n - i] = _mm256_extractf128_ps(areas, 1);
+    left_count[i] = lc;
+    right_count[n - i] = rc;
   }
-  acc[0] = acc[1] = acc[2] = empty;
-  cnt = _mm_setzero_si128();
   __m128 best_w = _mm_set1_ps(kInf), best_la = _mm_setzero_ps(), best_ra = _mm_setzero_ps();
   __m128i best_i = _mm_setzero_si128(), best_lc = _mm_setzero_si128();
   for (int i = 1; i < n; ++i) {
-    extend(acc, i - 1);
-    cnt = _mm_add_epi32(cnt, counts(i - 1));
-    const __m128 la = areas(acc), ra = right_area[i];
+    const __m128 la = left_area[i], ra = right_area[i];
+    const __m128i cnt = left_count[i];
     const __m128 w =
         _mm_add_ps(_mm_mul_ps(la, _mm_cvtepi32_ps(cnt)), _mm_mul_ps(ra, _mm_cvtepi32_ps(right_count[i])));
     const __m128i empty_side = _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()),
@@ -238,17 +251,17 @@ inline SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float 
         _mm_blendv_ps(_mm_castsi128_ps(best_i), _mm_castsi128_ps(_mm_set1_epi32(i)), better));
     best_lc = _mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(best_lc), _mm_castsi128_ps(cnt), better));
   }
-  alignas(16) int32_t bi[4], lc[4], total[4];
+  alignas(16) int32_t bi[4], lcs[4], total[4];
   alignas(16) float bla[4], bra[4];
   _mm_store_si128(reinterpret_cast<__m128i*>(bi), best_i);
-  _mm_store_si128(reinterpret_cast<__m128i*>(lc), best_lc);
-  _mm_store_si128(reinterpret_cast<__m128i*>(total), _mm_add_epi32(cnt, counts(n - 1)));
+  _mm_store_si128(reinterpret_cast<__m128i*>(lcs), best_lc);
+  _mm_store_si128(reinterpret_cast<__m128i*>(total), _mm_add_epi32(lc, bins.counts(n - 1)));
   _mm_store_ps(bla, best_la);
   _mm_store_ps(bra, best_ra);
   SahSplit best;
   for (int a = 0; a < 3; ++a) {
     if (bi[a] == 0) continue;
-    const float c = costs.split(parent_area, bla[a], uint32_t(lc[a]), bra[a], uint32_t(total[a] - lc[a]));
+    const float c = costs.split(parent_area, bla[a], uint32_t(lcs[a]), bra[a], uint32_t(total[a] - lcs[a]));
     if (c < best.cost) best = {a, bi[a], c};
   }
   return best;
