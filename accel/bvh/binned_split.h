@@ -126,6 +126,8 @@ struct NegBox8 {
   }
 };
 
+static_assert(sizeof(NegBox8) == 32);  // BinSet::put addresses the bins by byte offsets of 32 per bin
+
 /// The bins of one node on the three axes, reducible in parallel: the box of axis a, bin k at a * nb + k,
 /// its count at 4 k + a (the three axes' counts of a bin are one vector for the sweep).
 struct BinSet {
@@ -145,16 +147,17 @@ struct BinSet {
   /// the same either way.
   void add(const BinRef* refs, uint32_t b, uint32_t e, const BinIndexer& ix) {
     uint32_t k = b;
+    const __m128i first = axis_first();
     if (e - b < kTwoSetBinning) {
-      for (; k < e; ++k) put(refs[k], ix);
+      for (; k < e; ++k) put(refs[k], ix, first);
       return;
     }
     BinSet odd(nb);
     for (; k + 1 < e; k += 2) {
-      put(refs[k], ix);
-      odd.put(refs[k + 1], ix);
+      put(refs[k], ix, first);
+      odd.put(refs[k + 1], ix, first);
     }
-    if (k < e) put(refs[k], ix);
+    if (k < e) put(refs[k], ix, first);
     merge(odd);
   }
   /// Adds the bins of o (exact: min, max and integer sums).
@@ -167,14 +170,23 @@ struct BinSet {
   /// Ranges at least this long are binned into two sets.
   static constexpr uint32_t kTwoSetBinning = 256;
 
-  /// Adds the reference to its bin on each axis.
-  void put(const BinRef& ref, const BinIndexer& ix) {
+  /// The index of each axis's first bin (0, nb, 2 nb).
+  __m128i axis_first() const { return _mm_setr_epi32(0, nb, 2 * nb, 0); }
+  /// Adds the reference to its bin on each axis (axis_first() passed in). The byte offsets of its three boxes
+  /// and counts are computed in one vector each.
+  void put(const BinRef& ref, const BinIndexer& ix, __m128i axis_first) {
     const __m256 b = NegBox8::of(ref);
-    alignas(16) int32_t bin[4];
-    _mm_store_si128(reinterpret_cast<__m128i*>(bin), ix.bins(NegBox8::center(b)));
+    const __m128i bin = ix.bins(NegBox8::center(b));
+    alignas(16) int32_t box_at[4], count_at[4];
+    const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+    _mm_store_si128(reinterpret_cast<__m128i*>(box_at), _mm_slli_epi32(_mm_add_epi32(bin, axis_first), 5));
+    _mm_store_si128(reinterpret_cast<__m128i*>(count_at),
+                    _mm_slli_epi32(_mm_add_epi32(_mm_slli_epi32(bin, 2), lane), 2));
+    char* boxes = reinterpret_cast<char*>(box.data());
+    char* counts = reinterpret_cast<char*>(count.data());
     for (int a = 0; a < 3; ++a) {
-      box[a * nb + bin[a]].extend(b);
-      ++count[4 * bin[a] + a];
+      reinterpret_cast<NegBox8*>(boxes + box_at[a])->extend(b);
+      ++*reinterpret_cast<uint32_t*>(counts + count_at[a]);
     }
   }
 };
