@@ -97,8 +97,8 @@ struct SideBounds {
 /// Moves refs [b, e) into out, the left ones from cursor l on and the others from cursor r on, in order,
 /// and returns both sides' centroid bounds. Branch-free: each reference is written at the cursor of its
 /// side (a conditional move, not a mispredicted branch); the bounds are kept in registers.
-SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t e, uint32_t l, uint32_t r,
-                           const SideTest& side) {
+[[gnu::noinline]] SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t e,
+                                             uint32_t l, uint32_t r, const SideTest& side) {
   const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
   Box4 lc = Box4::empty(), rc = Box4::empty();
   for (uint32_t k = b; k < e; ++k) {
@@ -118,7 +118,8 @@ SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t
 /// Partitions the block refs[0, n) in place through tmp (n <= kPartitionBlock): the left references to the
 /// front in order, the others behind them in reverse order. Returns the number of left ones and both sides'
 /// centroid bounds.
-std::pair<uint32_t, SideBounds> partition_block(BinRef* refs, uint32_t n, const SideTest& side, BinRef* tmp) {
+[[gnu::noinline]] std::pair<uint32_t, SideBounds> partition_block(BinRef* refs, uint32_t n,
+                                                                  const SideTest& side, BinRef* tmp) {
   const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
   Box4 lc = Box4::empty(), rc = Box4::empty();
   uint32_t l = 0, r = n - 1;
