@@ -9,6 +9,8 @@
 #include <array>
 #include <bit>
 #include <memory>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "accel/bvh/binned_split.h"
@@ -26,11 +28,16 @@ namespace {
 // centroids are projected into equal-width bins on all three axes in one pass (SSE: one vector of bin
 // indices and one box update per axis), every bin boundary is evaluated by a sweep over the bins, and the
 // range is partitioned at the cheapest one. The partition pass also computes the children's
-// centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. The
-// partition moves references between two buffers (a node's children live in the other buffer than the
-// node), so nothing is copied back per node; a leaf writes its ids to the leaf order from either buffer.
-// Nodes above kParallelReduceThreshold bin in parallel and subtrees above parallel_threshold are built in
-// parallel; the tree is the same for any number of threads.
+// centroid bounds, and their boxes are unions of bins, so no node needs a separate bounding pass. Nodes of
+// at least kParallelReduceThreshold references bin in parallel and are partitioned in place in the one
+// reference array, in parallel (partition_in_place). Below that, a subtree gets a scratch buffer of its
+// size, and its partitions move references between the array and the scratch (a node's children live in
+// the other buffer than the node), so nothing is copied back per node; a leaf writes its ids to the leaf
+// order from either buffer. Subtrees above parallel_threshold are built in parallel; the tree and the
+// leaf order are the same for any number of threads.
+/// References partitioned at once, through a buffer on the stack, by the in-place partition.
+constexpr uint32_t kPartitionBlock = 1024;
+
 class BinnedBuilder {
  public:
   BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds);
@@ -39,137 +46,31 @@ class BinnedBuilder {
   BvhSlotsResult run();
 
  private:
-  /// The children of a split node: their bounds, the first reference of the right one and their buffer.
+  /// The children of a split node: their bounds, the first reference of the right one, and whether they
+  /// were moved into the node's spare buffer.
   struct Children {
     NodeBounds left, right;
     uint32_t m = 0;
-    int buffer = 0;
+    bool moved = false;
   };
 
-  uint32_t build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, int buffer);
-  bool split(uint32_t b, uint32_t e, const NodeBounds& nb, int buffer, Children& out);
-  void make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer);
-  void partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis, int position,
-                 const BinMapping& map, Box4& left_c, Box4& right_c);
+  uint32_t build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth, BinRef* refs,
+                 BinRef* spare);
+  bool split(uint32_t b, uint32_t e, const NodeBounds& nb, BinRef* refs, BinRef* spare, Children& out);
+  void make_leaf(uint32_t p, uint32_t b, uint32_t e, const BinRef* refs);
   NodeBounds write_refs(const PrimBoundsSource& bounds);
 
   const BvhSahConfig& config_;
   size_t n_;
-  /// The references and the second partition buffer; uninitialized and on huge pages (huge_pages.h; every
-  /// element is written before it is read).
-  LargeArray<BinRef> buffers_[2];
+  /// The references; uninitialized and on huge pages (huge_pages.h; every element is written before it is
+  /// read).
+  LargeArray<BinRef> refs_;
   BvhSlots slots_;
   /// The leaf order of the ids, written by make_leaf from whichever buffer holds the leaf.
   std::vector<uint32_t> order_;
   /// The root's box and centroid box, gathered while the references are written.
   NodeBounds root_;
 };
-
-BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds)
-    : config_(config),
-      n_(n),
-      buffers_{LargeArray<BinRef>(n_), LargeArray<BinRef>(n_)},
-      slots_(n_),
-      order_(n_) {
-  root_ = write_refs(bounds);
-}
-
-/// Writes the references of all primitives into buffer 0 and returns their box and centroid box, in the
-/// same pass (a parallel reduction of exact min / max, so the result does not depend on the threads).
-NodeBounds BinnedBuilder::write_refs(const PrimBoundsSource& bounds) {
-  BinRef* refs = buffers_[0].get();
-  auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
-    AABB box[kBoundsBlock];  // a range may be longer than its grain: it is read block by block
-    for (size_t first = r.begin(); first < r.end(); first += kBoundsBlock) {
-      const size_t last = std::min(r.end(), first + kBoundsBlock);
-      bounds(first, last, box);
-      for (size_t i = first; i < last; ++i) {
-        const AABB& b = box[i - first];
-        refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
-        acc.box.extend(refs[i].lo4(), refs[i].hi4());
-        const __m128 c = refs[i].center();
-        acc.centroids.extend(c, c);
-      }
-    }
-    return acc;
-  };
-  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, n_, kGrain), NodeBounds{}, body,
-                              [](NodeBounds x, const NodeBounds& y) {
-                                x.box.extend(y.box);
-                                x.centroids.extend(y.centroids);
-                                return x;
-                              });
-}
-
-BvhSlotsResult BinnedBuilder::run() {
-  if (n_ > 0) build(0, 0, uint32_t(n_), root_, 0, 0);
-  return {std::move(slots_), std::move(order_)};
-}
-
-/// A leaf over [b, e): its ids go to the leaf order from the buffer that holds them (no references are
-/// copied back to one buffer, and no pass over all of them extracts the order at the end).
-void BinnedBuilder::make_leaf(uint32_t p, uint32_t b, uint32_t e, int buffer) {
-  slots_.set_leaf(p, b, e);
-  const BinRef* refs = buffers_[buffer].get();
-  for (uint32_t k = b; k < e; ++k) order_[k] = refs[k].id;
-}
-
-/// Splits [b, e) of buffers_[buffer] into children: at the cheapest bin boundary (partitioned into the
-/// other buffer) or, when no split is valid but the node is too large for a leaf, in the middle of the
-/// current order. Returns false when the node is a leaf.
-bool BinnedBuilder::split(uint32_t b, uint32_t e, const NodeBounds& nb, int buffer, Children& out) {
-  const uint32_t n = e - b;
-  const BinRef* refs = buffers_[buffer].get();
-  // Small nodes use as many bins as primitives (at least 4): more could not separate them better on
-  // average, and evaluating unused boundaries would dominate the cost near the leaves.
-  const BinMapping map(nb.centroids.aabb(), std::min(config_.bins, std::max(4, int(n))));
-  const BinnedSplit found = find_binned_split(refs, b, e, nb.box, map, config_.costs);
-  const uint32_t decision = sah_decision(n, found.sah, config_);
-  if (decision == 0) return false;
-  out.buffer = buffer;
-  if (decision == n) {
-    out.left.box = found.left;
-    out.right.box = found.right;
-    out.m = b + found.left_count;
-    out.buffer = 1 - buffer;
-    partition(refs, buffers_[out.buffer].get(), b, out.m, e, found.sah.axis, found.sah.position, map,
-              out.left.centroids, out.right.centroids);
-  } else {  // forced split in the middle of the current order
-    out.m = b + decision;
-    for (uint32_t k = b; k < e; ++k) {
-      NodeBounds& side = k < out.m ? out.left : out.right;
-      side.box.extend(refs[k].lo4(), refs[k].hi4());
-      side.centroids.extend(refs[k].center(), refs[k].center());
-    }
-  }
-  return true;
-}
-
-/// Builds the subtree of slot p over [b, e) of buffers_[buffer] and returns how many slots it takes. A node
-/// whose children are built in parallel gives them the gapped slots p + 1 and p + 2 (m - b) (slots.h); below
-/// parallel_threshold the subtree is laid out compactly, its right child in the slot after its left subtree,
-/// so the slots it leaves free are never touched (nor zeroed by the kernel) and the passes that read the
-/// slots (the collapse, the statistics walk, the flatten) read them densely. Either way the tree is the same.
-uint32_t BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth,
-                              int buffer) {
-  slots_.set_box(p, nb.box.aabb());
-  const uint32_t n = e - b;
-  Children c;
-  if (depth >= config_.max_depth || n == 1 || leaf_without_search(n, config_) ||
-      !split(b, e, nb, buffer, c)) {
-    make_leaf(p, b, e, buffer);
-    return 1;
-  }
-  if (n >= config_.parallel_threshold) {
-    const uint32_t right_slot = slots_.set_interior(p, b, c.m);
-    tbb::parallel_invoke([&] { build(p + 1, b, c.m, c.left, depth + 1, c.buffer); },
-                         [&] { build(right_slot, c.m, e, c.right, depth + 1, c.buffer); });
-    return 2 * n - 1;
-  }
-  const uint32_t left_slots = build(p + 1, b, c.m, c.left, depth + 1, c.buffer);
-  slots_.set_right(p, p + 1 + left_slots);
-  return 1 + left_slots + build(p + 1 + left_slots, c.m, e, c.right, depth + 1, c.buffer);
-}
 
 /// Which side of the split a reference goes to: its bin on the split's axis below the split's position, with
 /// the binning's own vector arithmetic (BinIndexer) on its centre, so bit for bit the bin it was counted in.
@@ -196,8 +97,8 @@ struct SideBounds {
 /// Moves refs [b, e) into out, the left ones from cursor l on and the others from cursor r on, in order,
 /// and returns both sides' centroid bounds. Branch-free: each reference is written at the cursor of its
 /// side (a conditional move, not a mispredicted branch); the bounds are kept in registers.
-SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t e, uint32_t l, uint32_t r,
-                           const SideTest& side) {
+[[gnu::noinline]] SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t e,
+                                             uint32_t l, uint32_t r, const SideTest& side) {
   const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
   Box4 lc = Box4::empty(), rc = Box4::empty();
   for (uint32_t k = b; k < e; ++k) {
@@ -214,34 +115,206 @@ SideBounds partition_range(const BinRef* refs, BinRef* out, uint32_t b, uint32_t
   return {lc, rc};
 }
 
-/// Partitions [b, e) stably into [b, m), the primitives whose bin on `axis` lies below `position` (m - b
-/// of them, known from the bins), and [m, e), from refs into out, gathering each side's centroid bounds.
-/// Large ranges are cut into blocks of kGrain: one parallel pass counts each block's left references, a
-/// prefix sum gives every block its two cursors, and a second parallel pass moves them (the same order as
-/// the serial pass, and the bounds are exact min / max, so the result does not depend on the threads).
-void BinnedBuilder::partition(const BinRef* refs, BinRef* out, uint32_t b, uint32_t m, uint32_t e, int axis,
-                              int position, const BinMapping& map, Box4& left_c, Box4& right_c) {
-  const SideTest side(map, axis, position);
-  if (e - b < kParallelReduceThreshold) {
-    const SideBounds s = partition_range(refs, out, b, e, b, m, side);
-    return left_c.extend(s.left), right_c.extend(s.right);
+/// Partitions the block refs[0, n) in place through tmp (n <= kPartitionBlock): the left references to the
+/// front in order, the others behind them in reverse order. Returns the number of left ones and both sides'
+/// centroid bounds.
+[[gnu::noinline]] std::pair<uint32_t, SideBounds> partition_block(BinRef* refs, uint32_t n,
+                                                                  const SideTest& side, BinRef* tmp) {
+  const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
+  Box4 lc = Box4::empty(), rc = Box4::empty();
+  uint32_t l = 0, r = n - 1;
+  for (uint32_t k = 0; k < n; ++k) {
+    const BinRef& ref = refs[k];
+    const __m128 c = ref.center();
+    const bool left = side.left(c);
+    tmp[left ? l : r] = ref;
+    l += left;
+    r -= !left;
+    const __m128 mask = _mm_castsi128_ps(_mm_set1_epi32(-int(left)));
+    lc.extend(_mm_blendv_ps(inf, c, mask), _mm_blendv_ps(minus_inf, c, mask));
+    rc.extend(_mm_blendv_ps(c, inf, mask), _mm_blendv_ps(c, minus_inf, mask));
   }
-  const size_t blocks = (e - b + kGrain - 1) / kGrain;
-  auto block_end = [&](size_t i) { return uint32_t(std::min<size_t>(e, b + (i + 1) * kGrain)); };
-  std::vector<uint32_t> lefts(blocks + 1, 0);
-  tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
-    uint32_t n = 0;
-    for (uint32_t k = uint32_t(b + i * kGrain), end = block_end(i); k < end; ++k) n += side.left(refs[k]);
-    lefts[i + 1] = n;
-  });
-  for (size_t i = 0; i < blocks; ++i) lefts[i + 1] += lefts[i];
+  std::copy(tmp, tmp + n, refs);
+  return {l, {lc, rc}};
+}
+
+/// A run of references [first, first + size) of one block that lie on the wrong side of the partition.
+struct Run {
+  uint32_t first, size;
+};
+
+/// Swaps the k-th misplaced reference of `rights` with the k-th of `lefts` for k in [k0, k1); the runs'
+/// prefix sums (`*_end`: references up to and including each run) locate the k0-th of each.
+void swap_misplaced(BinRef* refs, const std::vector<Run>& rights, const std::vector<uint32_t>& rights_end,
+                    const std::vector<Run>& lefts, const std::vector<uint32_t>& lefts_end, uint32_t k0,
+                    uint32_t k1) {
+  size_t i = size_t(std::upper_bound(rights_end.begin(), rights_end.end(), k0) - rights_end.begin());
+  size_t j = size_t(std::upper_bound(lefts_end.begin(), lefts_end.end(), k0) - lefts_end.begin());
+  uint32_t a = rights[i].first + (k0 - (rights_end[i] - rights[i].size));
+  uint32_t c = lefts[j].first + (k0 - (lefts_end[j] - lefts[j].size));
+  for (uint32_t k = k0; k < k1; ++k) {
+    if (a == rights[i].first + rights[i].size) a = rights[++i].first;
+    if (c == lefts[j].first + lefts[j].size) c = lefts[++j].first;
+    std::swap(refs[a++], refs[c++]);
+  }
+}
+
+/// Partitions refs[0, n) in place so that the nl references whose bin lies below the split come first,
+/// and returns both sides' centroid bounds (Wald 2007's partition, done in place in parallel as in Embree's
+/// parallel_partition, here with fixed blocks so that the order does not depend on the threads): each block
+/// of kPartitionBlock is partitioned on its own, in parallel; then the right references that lie before nl
+/// are swapped with the left ones that lie after it, the k-th with the k-th, in parallel chunks. Exact min
+/// / max bounds, so the result does not depend on the threads either.
+SideBounds partition_in_place(BinRef* refs, uint32_t n, uint32_t nl, const SideTest& side) {
+  const size_t blocks = (n + kPartitionBlock - 1) / kPartitionBlock;
+  std::vector<uint32_t> lefts(blocks);
   std::vector<SideBounds> bounds(blocks);
   tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
-    const uint32_t first = uint32_t(b + i * kGrain);
-    bounds[i] =
-        partition_range(refs, out, first, block_end(i), b + lefts[i], m + (first - b - lefts[i]), side);
+    alignas(32) BinRef tmp[kPartitionBlock];
+    const uint32_t first = uint32_t(i * kPartitionBlock);
+    const uint32_t size = std::min(n - first, uint32_t(kPartitionBlock));
+    std::tie(lefts[i], bounds[i]) = partition_block(refs + first, size, side, tmp);
   });
-  for (const SideBounds& s : bounds) left_c.extend(s.left), right_c.extend(s.right);
+  SideBounds all;
+  std::vector<Run> rights_before, lefts_after;  // the misplaced runs, in position order
+  for (size_t i = 0; i < blocks; ++i) {
+    all.left.extend(bounds[i].left);
+    all.right.extend(bounds[i].right);
+    const uint32_t first = uint32_t(i * kPartitionBlock), mid = first + lefts[i];
+    const uint32_t last = std::min(n, first + uint32_t(kPartitionBlock));
+    if (mid < std::min(last, nl)) rights_before.push_back({mid, std::min(last, nl) - mid});
+    if (std::max(first, nl) < mid) lefts_after.push_back({std::max(first, nl), mid - std::max(first, nl)});
+  }
+  auto ends = [](const std::vector<Run>& runs) {
+    std::vector<uint32_t> end(runs.size());
+    for (size_t i = 0, sum = 0; i < runs.size(); ++i) end[i] = uint32_t(sum += runs[i].size);
+    return end;
+  };
+  const std::vector<uint32_t> rights_end = ends(rights_before), lefts_end = ends(lefts_after);
+  const uint32_t misplaced = rights_end.empty() ? 0 : rights_end.back();
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, misplaced, kPartitionBlock),
+                    [&](const tbb::blocked_range<uint32_t>& r) {
+                      swap_misplaced(refs, rights_before, rights_end, lefts_after, lefts_end, r.begin(),
+                                     r.end());
+                    });
+  return all;
+}
+
+BinnedBuilder::BinnedBuilder(const BvhSahConfig& config, size_t n, const PrimBoundsSource& bounds)
+    : config_(config), n_(n), refs_(n_), slots_(n_), order_(n_) {
+  root_ = write_refs(bounds);
+}
+
+/// Writes the references of all primitives and returns their box and centroid box, in the
+/// same pass (a parallel reduction of exact min / max, so the result does not depend on the threads).
+NodeBounds BinnedBuilder::write_refs(const PrimBoundsSource& bounds) {
+  BinRef* refs = refs_.get();
+  auto body = [&](const tbb::blocked_range<size_t>& r, NodeBounds acc) {
+    AABB box[kBoundsBlock];  // a range may be longer than its grain: it is read block by block
+    for (size_t first = r.begin(); first < r.end(); first += kBoundsBlock) {
+      const size_t last = std::min(r.end(), first + kBoundsBlock);
+      bounds(first, last, box);
+      for (size_t i = first; i < last; ++i) {
+        const AABB& b = box[i - first];
+        refs[i] = {{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}, 0.0f};
+        acc.box.extend(refs[i].lo4(), refs[i].hi4());
+        const __m128 c = refs[i].center();
+        acc.centroids.extend(c, c);
+      }
+    }
+    return acc;
+  };
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, n_, kGrain), NodeBounds{}, body,
+                              [](NodeBounds x, const NodeBounds& y) {
+                                x.box.extend(y.box);
+                                x.centroids.extend(y.centroids);
+                                return x;
+                              });
+}
+
+BvhSlotsResult BinnedBuilder::run() {
+  if (n_ > 0) build(0, 0, uint32_t(n_), root_, 0, refs_.get(), nullptr);
+  return {std::move(slots_), std::move(order_)};
+}
+
+/// A leaf over [b, e), whose references start at refs: its ids go to the leaf order from the buffer that
+/// holds them (no references are copied back to one buffer, and no pass over all of them extracts the order
+/// at the end).
+void BinnedBuilder::make_leaf(uint32_t p, uint32_t b, uint32_t e, const BinRef* refs) {
+  slots_.set_leaf(p, b, e);
+  for (uint32_t k = b; k < e; ++k) order_[k] = refs[k - b].id;
+}
+
+/// Splits [b, e), whose references start at refs, into children: at the cheapest bin boundary (partitioned
+/// into `spare`, or in place when there is no spare buffer) or, when no split is valid but the node is too
+/// large for a leaf, in the middle of the current order. Returns false when the node is a leaf.
+bool BinnedBuilder::split(uint32_t b, uint32_t e, const NodeBounds& nb, BinRef* refs, BinRef* spare,
+                          Children& out) {
+  const uint32_t n = e - b;
+  // Small nodes use as many bins as primitives (at least 4): more could not separate them better on
+  // average, and evaluating unused boundaries would dominate the cost near the leaves.
+  const BinMapping map(nb.centroids.aabb(), std::min(config_.bins, std::max(4, int(n))));
+  const BinnedSplit found = find_binned_split(refs, 0, n, nb.box, map, config_.costs);
+  const uint32_t decision = sah_decision(n, found.sah, config_);
+  if (decision == 0) return false;
+  if (decision == n) {
+    out.left.box = found.left;
+    out.right.box = found.right;
+    out.m = b + found.left_count;
+    const SideTest side(map, found.sah.axis, found.sah.position);
+    const SideBounds s = spare ? partition_range(refs, spare, 0, n, 0, found.left_count, side)
+                               : partition_in_place(refs, n, found.left_count, side);
+    out.left.centroids = s.left;
+    out.right.centroids = s.right;
+    out.moved = spare != nullptr;
+  } else {  // forced split in the middle of the current order
+    out.m = b + decision;
+    for (uint32_t k = 0; k < n; ++k) {
+      NodeBounds& side = k < decision ? out.left : out.right;
+      side.box.extend(refs[k].lo4(), refs[k].hi4());
+      side.centroids.extend(refs[k].center(), refs[k].center());
+    }
+  }
+  return true;
+}
+
+/// Builds the subtree of slot p over [b, e), whose references start at refs (with `spare`, the same range
+/// of the other buffer, or null above kParallelReduceThreshold), and returns how many slots it takes. A
+/// node whose children are built in parallel gives them the gapped slots p + 1 and p + 2 (m - b)
+/// (slots.h); below parallel_threshold the subtree is laid out compactly, its right child in the slot after
+/// its left subtree, so the slots it leaves free are never touched (nor zeroed by the kernel) and the passes
+/// that read the slots (the collapse, the statistics walk, the flatten) read them densely. Either way the
+/// tree is the same.
+uint32_t BinnedBuilder::build(uint32_t p, uint32_t b, uint32_t e, const NodeBounds& nb, int depth,
+                              BinRef* refs, BinRef* spare) {
+  slots_.set_box(p, nb.box.aabb());
+  const uint32_t n = e - b;
+  if (depth >= config_.max_depth || n == 1 || leaf_without_search(n, config_)) {
+    make_leaf(p, b, e, refs);
+    return 1;
+  }
+  std::unique_ptr<BinRef[]> scratch;  // the spare buffer of a subtree below the in-place partitions
+  if (spare == nullptr && n < kParallelReduceThreshold) {
+    scratch = std::make_unique_for_overwrite<BinRef[]>(n);
+    spare = scratch.get();
+  }
+  Children c;
+  if (!split(b, e, nb, refs, spare, c)) {
+    make_leaf(p, b, e, refs);
+    return 1;
+  }
+  if (c.moved) std::swap(refs, spare);
+  BinRef* right_refs = refs + (c.m - b);
+  BinRef* right_spare = spare ? spare + (c.m - b) : nullptr;
+  if (n >= config_.parallel_threshold) {
+    const uint32_t right_slot = slots_.set_interior(p, b, c.m);
+    tbb::parallel_invoke([&] { build(p + 1, b, c.m, c.left, depth + 1, refs, spare); },
+                         [&] { build(right_slot, c.m, e, c.right, depth + 1, right_refs, right_spare); });
+    return 2 * n - 1;
+  }
+  const uint32_t left_slots = build(p + 1, b, c.m, c.left, depth + 1, refs, spare);
+  slots_.set_right(p, p + 1 + left_slots);
+  return 1 + left_slots + build(p + 1 + left_slots, c.m, e, c.right, depth + 1, right_refs, right_spare);
 }
 
 }  // namespace
