@@ -344,7 +344,9 @@ class BspBuilder {
   Children children(const NodePrims& np, const ConvexCell& cell, const Depth& depth, const Step& s) const {
     const size_t n = np.size(), nl = s.nl, nr = s.nr;
     Children c;
-    std::tie(c.cells[0], c.cells[1]) = cell.parts(s.d.plane);
+    // An empty child is a leaf whose cell is never read: only the others' cells are made (at 1M
+    // triangles a fifth of the parts).
+    std::tie(c.cells[0], c.cells[1]) = cell.parts(s.d.plane, nl > 0, nr > 0);
     c.prims[0] = child_prims(np, s.sides, 1, s.d.plane, c.cells[0]);
     c.prims[1] = child_prims(np, s.sides, 2, s.d.plane, c.cells[1]);
     const bool shave = is_shave(nl, nr, n, !s.d.forced,

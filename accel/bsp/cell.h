@@ -106,17 +106,20 @@ class ConvexCell {
   /// one of the cell's own faces) leaves the whole cell on that side and nothing on the other, so no
   /// face is ever duplicated.
   ConvexCell part(const BspPlane& p, bool below) const {
-    std::pair<ConvexCell, ConvexCell> both = parts(p, below ? kBelow : kAbove);
+    std::pair<ConvexCell, ConvexCell> both = parts_of(p, below ? kBelow : kAbove);
     return below ? std::move(both.first) : std::move(both.second);
   }
-  /// Both parts (below, above) of part(): the vertices' distances from the plane computed once.
-  std::pair<ConvexCell, ConvexCell> parts(const BspPlane& p) const { return parts(p, kBelow | kAbove); }
+  /// Both parts (below, above) of part(): the vertices' distances from the plane computed once. Only the
+  /// parts asked for (`below`, `above`) are made; the others are left empty.
+  std::pair<ConvexCell, ConvexCell> parts(const BspPlane& p, bool below = true, bool above = true) const {
+    return parts_of(p, (below ? kBelow : 0) | (above ? kAbove : 0));
+  }
 
  private:
   static constexpr int kBelow = 1, kAbove = 2;
 
   /// The parts of part() on the sides in `which` (the others left empty).
-  std::pair<ConvexCell, ConvexCell> parts(const BspPlane& p, int which) const {
+  std::pair<ConvexCell, ConvexCell> parts_of(const BspPlane& p, int which) const {
     thread_local std::vector<float> dist, tol;
     grow_buffer(dist, verts_.size());
     grow_buffer(tol, verts_.size());

@@ -15,10 +15,10 @@
 
 #include "accel/bvh/binned_split.h"
 #include "accel/bvh/build.h"
-#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/sah_split.h"
 #include "accel/bvh/slots.h"
 #include "accel/common/binning.h"
+#include "accel/common/huge_pages.h"
 
 namespace ab {
 

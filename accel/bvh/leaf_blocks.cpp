@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <type_traits>
 
-#include "accel/bvh/huge_pages.h"
 #include "accel/bvh/leaf_fill.h"
+#include "accel/common/huge_pages.h"
 
 namespace ab {
 

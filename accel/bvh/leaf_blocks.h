@@ -8,35 +8,12 @@
 #include <utility>
 #include <vector>
 
-#include "accel/bvh/cache_line_allocator.h"
 #include "accel/bvh/node8.h"
+#include "accel/common/cache_line_allocator.h"
 #include "accel/core/primitives.h"
 #include "accel/core/triangle4.h"
 
 namespace ab {
-
-/// CacheLineAllocator (64-byte aligned, huge pages from 2 MiB on) whose resize() default-initializes,
-/// which for a trivial T leaves the memory untouched: the first write, and with it the page faults and the
-/// kernel's zeroing, then happens in the parallel pass that fills the elements, not serially in the
-/// resize (which would also write every byte once more).
-template <class T>
-struct UninitializedAllocator : CacheLineAllocator<T> {
-  /// A stateless allocator.
-  UninitializedAllocator() = default;
-  /// Rebinding from another element type.
-  template <class U>
-  UninitializedAllocator(const UninitializedAllocator<U>&) {}
-  /// Default-initializes *p (no write for a trivial U).
-  template <class U>
-  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  /// Constructs *p from args.
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
 
 /// Leaf blocks in leaf order. Not zeroed by resize(): pack_leaf_blocks writes every block in parallel.
 using Triangle4Array = std::vector<Triangle4, UninitializedAllocator<Triangle4>>;

@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "accel/bvh/cache_line_allocator.h"
 #include "accel/bvh/motion_node.h"
 #include "accel/bvh/walk8.h"
+#include "accel/common/cache_line_allocator.h"
 
 #if defined(__AVX2__)
 #include <immintrin.h>

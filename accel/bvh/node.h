@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "accel/bvh/cache_line_allocator.h"
+#include "accel/common/cache_line_allocator.h"
 #include "accel/core/aabb.h"
 
 namespace ab {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "accel/bvh/cache_line_allocator.h"
+#include "accel/common/cache_line_allocator.h"
 #include "accel/core/aabb.h"
 
 namespace ab {

@@ -3,6 +3,9 @@
 // run (as the BVH's leaves do) instead of gathering them by id.
 #pragma once
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cstdint>
 #include <map>
 #include <string>
@@ -10,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "accel/common/cache_line_allocator.h"
 #include "accel/common/id_lists.h"
 #include "accel/common/mailbox.h"
 #include "accel/core/primitives.h"
@@ -37,7 +41,7 @@ class LeafRefs {
   /// True when the primitive set can be copied into leaf order.
   static constexpr bool kCanCopy = std::is_same_v<P, TrianglePrims>;
 
-  /// Takes the leaf-ordered ids and copies the triangles they name as `mode` says.
+  /// Takes the leaf-ordered ids and copies the triangles they name as `mode` says (in parallel).
   void assign(const P& prims, std::vector<uint32_t> ids, LeafCopies mode) {
     ids_ = std::move(ids);
     tris_.clear();
@@ -45,7 +49,9 @@ class LeafRefs {
       const bool few = double(ids_.size()) <= kAutoCopyReferences * double(prims.size());
       if (mode == LeafCopies::kOn || (mode == LeafCopies::kAuto && few)) {
         tris_.resize(ids_.size());
-        for (size_t k = 0; k < ids_.size(); ++k) tris_[k] = prims.triangle(ids_[k]);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, ids_.size(), size_t(1) << 14), [&](const auto& r) {
+          for (size_t k = r.begin(); k < r.end(); ++k) tris_[k] = prims.triangle(ids_[k]);
+        });
       }
     }
   }
@@ -116,7 +122,8 @@ class LeafRefs {
 
  private:
   std::vector<uint32_t> ids_;
-  std::vector<Triangle> tris_;
+  /// The copies: not zeroed by resize(), each written once by the parallel copy (its first touch).
+  std::vector<Triangle, UninitializedAllocator<Triangle>> tris_;
 };
 
 }  // namespace ab
