@@ -183,7 +183,7 @@ bool same_bytes(const A& a, const A& b) {
 TEST(BvhBuild, BinnedSlotLayoutAndCollapseFromSlotsKeepTheTree) {
   // The binned builder lays serial subtrees out compactly and parallel ones in gapped slots: with every
   // node above the parallel threshold or every node below it, the flattened tree and the leaf order are
-  // the same, and the greedy collapse straight from the slots is the collapse of the flattened tree.
+  // the same, and either collapse straight from the slots is that collapse of the flattened tree.
   const Inputs in = inputs_of(random_soup(20000, 23, 0.02f));
   BvhSahConfig compact, gapped;
   compact.parallel_threshold = size_t(1) << 30;
@@ -195,8 +195,11 @@ TEST(BvhBuild, BinnedSlotLayoutAndCollapseFromSlotsKeepTheTree) {
   for (const BvhSahConfig& config : {compact, gapped}) {
     const BvhSlotsResult slots = build_bvh_slots(config, in.bounds);
     EXPECT_EQ(slots.order, a.order);
-    EXPECT_TRUE(same_bytes(collapse_to_bvh8(slots.slots), collapse_to_bvh8(a.nodes)));
+    for (const BvhCollapse method : {BvhCollapse::greedy, BvhCollapse::optimal})
+      EXPECT_TRUE(same_bytes(collapse_to_bvh8(slots.slots, method), collapse_to_bvh8(a.nodes, method)));
   }
+  EXPECT_FALSE(same_bytes(collapse_to_bvh8(a.nodes, BvhCollapse::greedy),
+                          collapse_to_bvh8(a.nodes, BvhCollapse::optimal)));
 }
 
 TEST(BvhBuild, BinnedChildBoxesAreTightAndLeavesAPermutation) {

@@ -217,15 +217,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     });
   }
 
-  /// True when the wide tree is the greedy collapse of a binned build, which collapses straight from the
-  /// builder's slots (no flattened binary tree).
+  /// True when the wide tree is the collapse of a binned build, which collapses straight from the builder's
+  /// slots (no flattened binary tree).
   bool collapses_from_slots() const {
-    if constexpr (std::is_same_v<C, BvhSahConfig>)
-      return config_.width == 8 && config_.collapse == BvhCollapse::greedy;
+    if constexpr (std::is_same_v<C, BvhSahConfig>) return config_.width == 8;
     return false;
   }
 
-  /// The binned build collapsed greedily from its slots, keeping the binary tree's figures for the report
+  /// The binned build collapsed from its slots, keeping the binary tree's figures for the report
   /// (the statistics walk sees the slots' tree as it would see the flattened one).
   void build_wide_from_slots() {
     if constexpr (std::is_same_v<C, BvhSahConfig>) {
@@ -241,7 +240,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
           [&] {
             if (built.slots.size > 0) walk_tree_stats(BvhSlotsVisitor{built.slots}, binary_);
           },
-          [&] { wide_ = collapse_to_bvh8(built.slots); });
+          [&] { wide_ = collapse_to_bvh8(built.slots, config_.collapse); });
       BvhNodeArray().swap(nodes_);
     }
   }

@@ -1,6 +1,9 @@
 #include "accel/bvh/collapse.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace ab {
@@ -83,61 +86,80 @@ class GreedyChildren {
 // minimize is the traversal cost times the summed area of the wide nodes: F(n, i) is the least summed area
 // of the wide nodes made from the binary subtree n as a forest of at most i lanes. For a leaf F(n, i) = 0;
 // for an interior node with children l, r, D(n, j) = min over 0 < k < j of F(l, k) + F(r, j - k),
-// F(n, 1) = A(n) + D(n, 8) (n becomes a wide node) and F(n, i) = min(F(n, 1), D(n, i)). Children come after
-// their parents in the binary array, so one reverse pass evaluates it; the choices are kept and replayed from
-// the root.
+// F(n, 1) = A(n) + D(n, 8) (n becomes a wide node) and F(n, i) = min(F(n, 1), D(n, i)). F is evaluated
+// bottom up by a recursion whose top levels run their two subtrees in parallel, each node's F handed to its
+// parent (only the choices are kept, 9 bytes a node); the choices are replayed from the root. Over
+// PairedTree or SlotTree (straight from the builder's slots, whose unused slots are never read).
+template <class Tree>
 class OptimalChildren {
  public:
-  explicit OptimalChildren(const BvhNodeArray& binary)
-      : binary_(binary), cost_(binary.size() * kW), split_(binary.size() * kW), open_(binary.size()) {
-    for (size_t n = binary.size(); n-- > 0;)
-      if (n != 1 && !binary[n].is_leaf()) evaluate(uint32_t(n));
+  /// The choices over binary tree `binary` of `size` nodes or slots.
+  OptimalChildren(const Tree& binary, size_t size)
+      : binary_(binary),
+        split_(std::make_unique_for_overwrite<Lanes<uint8_t>[]>(size)),
+        open_(std::make_unique_for_overwrite<uint8_t[]>(size)) {
+    evaluate(0, 0);
   }
 
   /// Children of binary interior node b: its subtree as the cheapest forest of at most eight lanes.
   Kids children_of(uint32_t b) const {
     Kids kids;
-    forest(binary_[b].offset, open_[b], kids);
-    forest(binary_[b].offset + 1, kW - open_[b], kids);
+    forest(binary_.left(b), open_[b], kids);
+    forest(binary_.right(b), kW - open_[b], kids);
     return kids;
   }
 
  private:
   static constexpr int kW = Bvh8Node::kWidth;
+  /// Nodes this shallow evaluate their two subtrees in parallel.
+  static constexpr int kParallelDepth = 10;
+  /// One value per lane count i = 1..8 (at i - 1).
+  template <class T>
+  using Lanes = std::array<T, kW>;
 
-  void evaluate(uint32_t n) {
-    const uint32_t l = binary_[n].offset, r = l + 1;
+  /// F(n, i) for i = 1..8 (zero for a leaf); records n's choices.
+  Lanes<float> evaluate(uint32_t n, int depth) {
+    if (binary_[n].is_leaf()) return Lanes<float>{};
+    Lanes<float> fl, fr;
+    const uint32_t l = binary_.left(n), r = binary_.right(n);
+    if (depth < kParallelDepth) {
+      tbb::parallel_invoke([&] { fl = evaluate(l, depth + 1); }, [&] { fr = evaluate(r, depth + 1); });
+    } else {
+      fl = evaluate(l, depth + 1);
+      fr = evaluate(r, depth + 1);
+    }
     float best[kW + 1];
     uint8_t best_k[kW + 1];
     for (int j = 2; j <= kW; ++j) {
       best[j] = kInf;
       for (int k = 1; k < j; ++k) {
-        const float c = cost_[size_t(l) * kW + k - 1] + cost_[size_t(r) * kW + j - k - 1];
+        const float c = fl[size_t(k - 1)] + fr[size_t(j - k - 1)];
         if (c < best[j]) best[j] = c, best_k[j] = uint8_t(k);
       }
     }
     const float as_node = binary_[n].box().area() + best[kW];
     open_[n] = best_k[kW];
-    cost_[size_t(n) * kW] = as_node;
-    split_[size_t(n) * kW] = 0;
+    Lanes<float> f;
+    f[0] = as_node;
+    split_[n][0] = 0;
     for (int i = 2; i <= kW; ++i) {
       const bool open = best[i] < as_node;
-      cost_[size_t(n) * kW + i - 1] = open ? best[i] : as_node;
-      split_[size_t(n) * kW + i - 1] = open ? best_k[i] : 0;
+      f[size_t(i - 1)] = open ? best[i] : as_node;
+      split_[n][size_t(i - 1)] = open ? best_k[i] : 0;
     }
+    return f;
   }
   /// Appends the forest chosen for F(n, i).
   void forest(uint32_t n, int i, Kids& kids) const {
-    const int k = binary_[n].is_leaf() ? 0 : split_[size_t(n) * kW + i - 1];
+    const int k = binary_[n].is_leaf() ? 0 : split_[n][size_t(i - 1)];
     if (k == 0) return kids.insert(kids.size(), n);
-    forest(binary_[n].offset, k, kids);
-    forest(binary_[n].offset + 1, i - k, kids);
+    forest(binary_.left(n), k, kids);
+    forest(binary_.right(n), i - k, kids);
   }
 
-  const BvhNodeArray& binary_;
-  std::vector<float> cost_;     ///< F(n, i) at n * 8 + i - 1
-  std::vector<uint8_t> split_;  ///< 0: n is one lane; else the lanes of the left child in F(n, i)
-  std::vector<uint8_t> open_;   ///< the left child's lanes when n becomes a wide node
+  const Tree& binary_;
+  std::unique_ptr<Lanes<uint8_t>[]> split_;  ///< per node: 0 where n is one lane; else the left child's lanes
+  std::unique_ptr<uint8_t[]> open_;          ///< per node: the left child's lanes when n becomes a wide node
 };
 
 /// Recursive collapse of the binary tree (PairedTree or SlotTree) into the wide array, with the children
@@ -194,18 +216,13 @@ class Bvh8Collapser {
   Bvh8NodeArray& wide_;
 };
 
-}  // namespace
-
-// Collapse after Wald, Benthin and Boulos 2008 (section 3: "pull up" the children of the largest-area
-// interior child until the node is full), applied top down to the binary SAH tree; or with the children
-// chosen by Ylitie, Karras and Laine 2017's dynamic programming (OptimalChildren above).
-Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method) {
+/// The collapse of binary tree `tree` (`size` nodes or slots) by `method`.
+template <class Tree>
+Bvh8NodeArray collapse_tree(const Tree& tree, size_t size, BvhCollapse method) {
   Bvh8NodeArray wide;
-  if (binary.empty()) return wide;
-  wide.reserve(binary.size() / 4 + 1);
-  const PairedTree tree{binary.data()};
-  if (method == BvhCollapse::optimal) {
-    const OptimalChildren children(binary);
+  wide.reserve(size / 4 + 1);
+  if (method == BvhCollapse::optimal && !tree[0].is_leaf()) {
+    const OptimalChildren children(tree, size);
     Bvh8Collapser(tree, children, wide).run();
   } else {
     const GreedyChildren children(tree);
@@ -214,16 +231,21 @@ Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method) {
   return wide;
 }
 
-// The greedy collapse straight from the slots: a slot tree and its flattened array have the same nodes and
-// the same left-to-right order of children, so the wide tree is the same node for node.
-Bvh8NodeArray collapse_to_bvh8(const BvhSlots& slots) {
-  Bvh8NodeArray wide;
-  if (slots.size == 0) return wide;
-  wide.reserve(slots.size / 4 + 1);
-  const SlotTree tree{slots.slots.get()};
-  const GreedyChildren children(tree);
-  Bvh8Collapser(tree, children, wide).run();
-  return wide;
+}  // namespace
+
+// Collapse after Wald, Benthin and Boulos 2008 (section 3: "pull up" the children of the largest-area
+// interior child until the node is full), applied top down to the binary SAH tree; or with the children
+// chosen by Ylitie, Karras and Laine 2017's dynamic programming (OptimalChildren above).
+Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method) {
+  if (binary.empty()) return {};
+  return collapse_tree(PairedTree{binary.data()}, binary.size(), method);
+}
+
+// The same straight from the slots: a slot tree and its flattened array have the same nodes and the same
+// left-to-right order of children, so the wide tree is the same node for node.
+Bvh8NodeArray collapse_to_bvh8(const BvhSlots& slots, BvhCollapse method) {
+  if (slots.size == 0) return {};
+  return collapse_tree(SlotTree{slots.slots.get()}, slots.size, method);
 }
 
 }  // namespace ab

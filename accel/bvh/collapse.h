@@ -16,8 +16,8 @@ namespace ab {
 /// wide root holds it as its only lane.
 Bvh8NodeArray collapse_to_bvh8(const BvhNodeArray& binary, BvhCollapse method = BvhCollapse::greedy);
 
-/// The greedy collapse of a binary tree still in its builder's slots (slots.h; root at slot 0), without
+/// The same collapse of a binary tree still in its builder's slots (slots.h; root at slot 0), without
 /// flattening it first: the same wide tree as flattening and then collapsing.
-Bvh8NodeArray collapse_to_bvh8(const BvhSlots& slots);
+Bvh8NodeArray collapse_to_bvh8(const BvhSlots& slots, BvhCollapse method = BvhCollapse::greedy);
 
 }  // namespace ab
