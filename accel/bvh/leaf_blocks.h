@@ -4,8 +4,6 @@
 
 #include <cstdint>
 #include <span>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "accel/bvh/node8.h"
