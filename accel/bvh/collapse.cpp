@@ -132,6 +132,7 @@ class OptimalChildren {
     uint8_t best_k[kW + 1];
     for (int j = 2; j <= kW; ++j) {
       best[j] = kInf;
+      best_k[j] = 1;  // a valid choice when every cost is infinite (areas overflow beyond about 1e19)
       for (int k = 1; k < j; ++k) {
         const float c = fl[size_t(k - 1)] + fr[size_t(j - k - 1)];
         if (c < best[j]) best[j] = c, best_k[j] = uint8_t(k);
