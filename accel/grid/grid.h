@@ -156,6 +156,10 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
     if (cells_.ids.empty()) return;
+    if (far_origin(ray)) {
+      for (size_t i = 0; i < prims_->size(); ++i) prims_->template intersect<kCount>(i, ray, best, inst, c);
+      return;
+    }
     const RayBoxData rd(ray);
     float t0 = ray.tmin, t1 = std::min(ray.tmax, best.t);
     if (!slab_test(layout_.box, rd, t0, t1)) return;
@@ -173,6 +177,11 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
     if (cells_.ids.empty()) return false;
+    if (far_origin(ray)) {
+      for (size_t i = 0; i < prims_->size(); ++i)
+        if (prims_->template occluded<kCount>(i, ray, c)) return true;
+      return false;
+    }
     const RayBoxData rd(ray);
     float t0 = ray.tmin, t1 = ray.tmax;
     if (!slab_test(layout_.box, rd, t0, t1)) return false;
@@ -229,6 +238,18 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   }
 
  private:
+  /// True for a ray whose origin lies so far from the grid that the rounding of its walk and of the kernel
+  /// (a few ulps of the origin's coordinates) may exceed the insertion margin (2^-17 of the grid box's
+  /// largest extent or coordinate): an origin coordinate beyond 2^5 times that magnitude. Such a ray tests
+  /// every primitive, as brute does (found by an outside check: from 1e7 away, every plane of a unit grid
+  /// lies within one ulp of the origin's coordinates, and the walk took cells the kernel's hit was not in).
+  bool far_origin(const Ray& ray) const {
+    const vec3 e = layout_.box.extent();
+    const vec3 a = glm::max(glm::abs(layout_.box.lo), glm::abs(layout_.box.hi));
+    const float reach = 0x1p5f * std::max({e.x, e.y, e.z, a.x, a.y, a.z});
+    const vec3 o = glm::abs(ray.org);
+    return !(std::max({o.x, o.y, o.z}) <= reach);
+  }
   /// Calls f(id) for each primitive of the walk's current cell not yet tested for this ray; stops early
   /// when f returns true (f may return void).
   template <bool kCount, class F>
