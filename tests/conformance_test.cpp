@@ -3,6 +3,8 @@
 // on every generator and ray kind, and on the real meshes. New structures are covered by registering.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <glm/gtc/matrix_transform.hpp>
@@ -145,6 +147,14 @@ std::string hit_string(const Hit& h) {
          " u=" + std::to_string(h.u) + " v=" + std::to_string(h.v);
 }
 
+/// A ray's floats in hexadecimal (exact, to reproduce a failure).
+std::string ray_string(const Ray& r) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "org (%a, %a, %a) dir (%a, %a, %a) tmin %a tmax %a", r.org.x, r.org.y,
+                r.org.z, r.dir.x, r.dir.y, r.dir.z, r.tmin, r.tmax);
+  return buf;
+}
+
 /// Traces rays with `name` at 1 and 2 threads (closest, counted, occluded) and expects brute's bits.
 void expect_same_as_brute(const Accelerator& accel, const Accelerator& brute, const std::vector<Ray>& rays,
                           const std::string& what) {
@@ -157,7 +167,8 @@ void expect_same_as_brute(const Accelerator& accel, const Accelerator& brute, co
     ASSERT_TRUE(r.identical()) << what << ", " << threads << " thread(s): " << r.differing << " of "
                                << rays.size() << " rays differ; first ray " << r.first_differences.front()
                                << ": expected " << hit_string(expected[r.first_differences.front()])
-                               << ", got " << hit_string(hits[r.first_differences.front()]);
+                               << ", got " << hit_string(hits[r.first_differences.front()]) << "; ray "
+                               << ray_string(rays[r.first_differences.front()]);
   }
   std::vector<Hit> counted(rays.size());
   const RayCounters c = trace_closest_counted(accel, rays, counted, 2);
@@ -262,6 +273,84 @@ TEST_P(Conformance, BothLevelsOfInstancing) {
   auto bottom = make_instance_accelerator("brute", instances_over(base_accel), Params{});
   bottom->build();
   expect_same_as_brute(*bottom, *all_brute, rays, "as bottom level");
+}
+
+/// Rays derived from brute's hits of `rays`, as a tracer makes secondary rays: from the hit point on
+/// (tmin 0, and tmin at the hit's own t), back towards the origin, reflected, and the original ray cut at
+/// the hit (tmax = t, tmin = t, both). Their hits lie within rounding of t = 0 or of the interval's ends,
+/// where an outside check found every BVH, the octree and the bsp missing hits brute reported (the kernel's
+/// rounding put them just outside the triangle's box; kernel_hit_in_box).
+std::vector<Ray> rays_from_hits(const Mesh& mesh, const std::vector<Ray>& rays) {
+  auto brute = make_accelerator("brute", std::make_shared<const TrianglePrims>(share(mesh)), Params{});
+  brute->build();
+  std::vector<Hit> hits(rays.size());
+  trace_closest(*brute, rays, hits, 1);
+  std::vector<Ray> out;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (!hits[i].found() || !std::isfinite(hits[i].t)) continue;
+    const Ray& r = rays[i];
+    const float t = hits[i].t;
+    const vec3 p = r.org + t * r.dir;
+    const Triangle tri = mesh.triangle(hits[i].prim);
+    const vec3 n = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+    const vec3 bounce =
+        glm::dot(n, n) > 0.0f ? r.dir - (2.0f * glm::dot(r.dir, n) / glm::dot(n, n)) * n : -r.dir;
+    out.push_back({p, r.dir, 0.0f, kInf});
+    out.push_back({p, r.dir, -1e-6f * (1.0f + std::fabs(t)), kInf});
+    out.push_back({p, -r.dir, 0.0f, kInf});
+    out.push_back({p, bounce, 0.0f, kInf});
+    out.push_back({r.org, r.dir, t, kInf});
+    out.push_back({r.org, r.dir, r.tmin, t});
+    out.push_back({r.org, r.dir, t, t});
+    out.push_back({r.org, r.dir, std::nextafter(t, kInf), kInf});
+  }
+  return out;
+}
+
+/// The same mesh far from the origin and far from the rays' origins, and at other scales.
+Mesh transformed(const Mesh& mesh, float scale, vec3 offset) {
+  Mesh m = mesh;
+  for (vec3& v : m.vertices) v = v * scale + offset;
+  return m;
+}
+
+TEST_P(Conformance, RaysFromHitPointsAndFarOrigins) {
+  // The outside check's smallest cases, each one triangle and one ray (brute's hit in the comment).
+  const Mesh one = one_triangle();
+  std::vector<Ray> exact = {
+      {{1.0f, 3.6915807e-08f, 1.1479106e-08f}, {0.34738958f, 0.64651322f, -0.67922097f}, 0.0f, kInf},
+      {{1.0f, -6.4549965e-09f, -1.5031716e-08f}, {26.261877f, 522.63513f, 612.48895f}, 0.0f, kInf},
+      {{0.25f, 0.25f, 1.0f}, {0.0f, 0.0f, -1.0f}, 0.0f, kInf}};  // and an ordinary hit
+  expect_same_as_brute(
+      *[&] {
+        auto a = make_accelerator(GetParam(), std::make_shared<const TrianglePrims>(share(one)), Params{});
+        a->build();
+        return a;
+      }(),
+      *[&] {
+        auto b = make_accelerator("brute", std::make_shared<const TrianglePrims>(share(one)), Params{});
+        b->build();
+        return b;
+      }(),
+      exact, "one triangle, hits outside its box by rounding");
+  const std::filesystem::path dir = std::filesystem::path(ACCELBENCH_SOURCE_DIR) / ".." / "shared" / "meshes";
+  Mesh base =
+      std::filesystem::exists(dir / "teapot.obj") ? read_mesh((dir / "teapot.obj").string()) : nasty_mix();
+  for (const auto& [scale, offset] :
+       {std::pair{1.0f, vec3(0.0f)}, std::pair{1e-5f, vec3(0.0f)}, std::pair{1e4f, vec3(0.0f)},
+        std::pair{1.0f, vec3(3e4f, -2e4f, 1e4f)},
+        std::pair{1e20f, vec3(0.0f)}}) {  // areas overflow: the collapse crashed
+    const Mesh mesh = transformed(base, scale, offset);
+    std::vector<Ray> rays = adversarial_rays(mesh, mesh.bounds(), 23);
+    rays.resize(std::min<size_t>(rays.size(), 1200));
+    for (size_t k = 0; k < mesh.size(); k += 1 + mesh.size() / 200) {  // from 1e7 away, at a vertex
+      const vec3 o = mesh.bounds().center() + vec3(7.7e6f, 5.9e6f, 2.4e6f);
+      rays.push_back({o, mesh.triangle(k).v0 - o, 0.0f, kInf});
+    }
+    std::vector<Ray> derived = rays_from_hits(mesh, rays);
+    derived.insert(derived.end(), rays.begin(), rays.end());
+    check_mesh(GetParam(), share(mesh), derived, "teapot x " + std::to_string(scale) + ", derived rays");
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Structures, Conformance, ::testing::ValuesIn(structure_names()),

@@ -115,6 +115,10 @@ template <class Corners>
     }
     corners.lanes(ids[j], q[j]);
     for (int c = 0; c < 3; ++c) lo = _mm_min_ps(lo, q[j][c]), hi = _mm_max_ps(hi, q[j][c]);
+    for (int c = 1; c < 3; ++c) {  // v0 + (v1 - v0) and v0 + (v2 - v0), as Triangle::bounds() holds them
+      const __m128 k = _mm_add_ps(q[j][0], _mm_sub_ps(q[j][c], q[j][0]));
+      lo = _mm_min_ps(lo, k), hi = _mm_max_ps(hi, k);
+    }
   }
   const auto corner = [&](int c) { return rows_of(q[0][c], q[1][c], q[2][c], q[3][c]); };
   const Vec3T<Lanes4> v0 = corner(0);

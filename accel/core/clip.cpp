@@ -70,7 +70,7 @@ void clip_polygon_to_box(ClipPolygon& poly, const AABB& box) {
 }
 
 AABB clipped_triangle_bounds(const Triangle& tri, const AABB& box) {
-  const AABB tb = tri.bounds();
+  const AABB tb = tri.vertex_bounds();
   if (!tb.overlaps(box)) return AABB{};
   // Fully inside: no clipping needed.
   if (box.contains(tb.lo) && box.contains(tb.hi)) return tb;

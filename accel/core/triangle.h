@@ -3,6 +3,7 @@
 #pragma once
 
 #include "accel/core/aabb.h"
+#include "accel/core/box_test.h"
 
 namespace ab {
 
@@ -10,8 +11,16 @@ namespace ab {
 struct Triangle {
   vec3 v0, v1, v2;
 
-  /// Bounds of the three vertices.
+  /// Bounds of the three vertices and of v0 + (v1 - v0) and v0 + (v2 - v0): the box every structure builds
+  /// over, which holds the box the kernel's acceptance tests a hit against (kernel_box).
   AABB bounds() const {
+    AABB b = vertex_bounds();
+    b.extend(v0 + (v1 - v0));
+    b.extend(v0 + (v2 - v0));
+    return b;
+  }
+  /// Bounds of the three vertices alone (the polygon clippers' input).
+  AABB vertex_bounds() const {
     AABB b;
     b.extend(v0);
     b.extend(v1);
@@ -145,12 +154,35 @@ inline bool kernel_calls_parallel(const Ray& ray, const Triangle& tri) {
   return !(lane_abs(dot(dir, cross(e1, e2))) > parallel_bound(dir, e1, e2));
 }
 
-/// The kernel for one triangle. Returns true and fills out on a hit.
+/// The box the kernel's acceptance tests a hit against: v0, v0 + e1 and v0 + e2 with the edges as the
+/// kernel computes them (triangle_terms), so a block of stored terms makes the same box. The sums may lie
+/// outside the vertices' box by rounding; Triangle::bounds() holds them.
+inline AABB kernel_box(const Vec3T<float>& v0, const Vec3T<float>& e1, const Vec3T<float>& e2) {
+  AABB b;
+  b.extend(vec3(v0.x, v0.y, v0.z));
+  b.extend(vec3(v0.x + e1.x, v0.y + e1.y, v0.z + e1.z));
+  b.extend(vec3(v0.x + e2.x, v0.y + e2.y, v0.z + e2.z));
+  return b;
+}
+
+/// The acceptance of a kernel hit at t: t must lie in the ray's crossing of the triangle's kernel_box as the
+/// box walks compute it (within_box_crossing). The kernel's rounding can put a hit a little outside the
+/// triangle, and so outside its box: a ray starting on the surface (t near 0, where the walks' relative
+/// widening is nothing) or leaving it past a vertex. Such a hit was found by brute but not by a structure
+/// that pruned the box; with this rule every structure and brute accept the same hits.
+inline bool kernel_hit_in_box(const Ray& ray, const TriangleTerms<float>& terms, float t) {
+  return within_box_crossing(ray, kernel_box(terms.v0, terms.e1, terms.e2), t);
+}
+
+/// The kernel for one triangle, with its acceptance (kernel_hit_in_box). Returns true and fills out on a
+/// hit.
 inline bool intersect_triangle(const Ray& ray, const Triangle& tri, TriangleHit& out) {
   float t, u, v;
-  if (!triangle_kernel<float>(to_lanes(ray.org), to_lanes(ray.dir), ray.tmin, ray.tmax, to_lanes(tri.v0),
-                              to_lanes(tri.v1), to_lanes(tri.v2), t, u, v))
+  const TriangleTerms<float> terms = triangle_terms(to_lanes(tri.v0), to_lanes(tri.v1), to_lanes(tri.v2));
+  const Vec3T<float> dir = to_lanes(ray.dir);
+  if (!triangle_kernel_terms<float>(to_lanes(ray.org), dir, l1_norm(dir), ray.tmin, ray.tmax, terms, t, u, v))
     return false;
+  if (!kernel_hit_in_box(ray, terms, t)) return false;
   out = {t, u, v};
   return true;
 }

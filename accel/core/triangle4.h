@@ -5,6 +5,7 @@
 
 #include <immintrin.h>
 
+#include <bit>
 #include <cstdint>
 #include <span>
 
@@ -85,22 +86,31 @@ struct alignas(64) Triangle4 {
   [[gnu::always_inline]] Vec3T<Lanes4> term(int r) const {
     return {Lanes4(_mm_load_ps(row[r][0])), Lanes4(_mm_load_ps(row[r][1])), Lanes4(_mm_load_ps(row[r][2]))};
   }
+  /// The terms of lane k.
+  TriangleTerms<float> lane_terms(int k) const {
+    TriangleTerms<float> out;
+    Vec3T<float>* rows[4] = {&out.v0, &out.e1, &out.e2, &out.n};
+    for (int r = 0; r < 4; ++r) *rows[r] = {row[r][0][k], row[r][1][k], row[r][2][k]};
+    return out;
+  }
   /// The four triangles' terms as the kernel takes them.
   [[gnu::always_inline]] TriangleTerms<Lanes4> terms() const { return {term(0), term(1), term(2), term(3)}; }
 };
 static_assert(sizeof(Triangle4) == 192);
 
 /// A ray broadcast to four lanes, with the L1 norm of its direction (made once per ray, as the kernel makes
-/// it).
+/// it), and the ray itself for the acceptance of a hit (kernel_hit_in_box; it must outlive this).
 struct Ray4 {
   explicit Ray4(const Ray& r)
       : org{Lanes4(r.org.x), Lanes4(r.org.y), Lanes4(r.org.z)},
         dir{Lanes4(r.dir.x), Lanes4(r.dir.y), Lanes4(r.dir.z)},
         l1_dir(l1_norm(to_lanes(r.dir))),
         tmin(r.tmin),
-        tmax(r.tmax) {}
+        tmax(r.tmax),
+        ray(&r) {}
   Vec3T<Lanes4> org, dir;
   Lanes4 l1_dir, tmin, tmax;
+  const Ray* ray;
 };
 
 /// The kernel on four triangles: returns the mask of lanes hit (bit k for lane k) and their t, u, v.
@@ -109,11 +119,15 @@ struct Ray4 {
   Lanes4 lt, lu, lv;
   const Mask4 hit = triangle_kernel_terms<Lanes4>(ray.org, ray.dir, ray.l1_dir, ray.tmin, ray.tmax,
                                                   tris.terms(), lt, lu, lv);
-  const unsigned mask = unsigned(_mm_movemask_ps(hit.m));
+  unsigned mask = unsigned(_mm_movemask_ps(hit.m));
   if (mask) {
     _mm_storeu_ps(t, lt.v);
     _mm_storeu_ps(u, lu.v);
     _mm_storeu_ps(v, lv.v);
+    for (unsigned rest = mask; rest; rest &= rest - 1) {  // the acceptance, lane by lane (hits are rare)
+      const int k = std::countr_zero(rest);
+      if (!kernel_hit_in_box(*ray.ray, tris.lane_terms(k), t[k])) mask &= ~(1u << k);
+    }
   }
   return mask;
 }
