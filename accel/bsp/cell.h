@@ -16,12 +16,12 @@
 
 namespace ab {
 
-/// The rounding band of a vertex's signed distance dot(n, v) - d from a plane: 1e-6 of |v| + |d|, relative
-/// to the magnitudes the distance is computed from. (An absolute floor of 1e-6, until an outside check,
-/// was 3 % of a teapot scaled by 1e-5: cells thinner than that were taken for no cut, and a triangle placed
-/// in such a cell lost its part there, and a ray through its vertex its hit.)
-inline float distance_band(const vec3& v, float d) {
-  return 1e-6f * (glm::length(v) + std::fabs(d));
+/// The rounding band of a vertex's signed distance from a plane: 1e-6 of 1 + |v|. (Its absolute floor is
+/// 3 % of a teapot scaled by 1e-5; a band relative to |v| alone, or to the root's magnitude, was too tight
+/// for the clipper on the bunny scaled by 1e-5, which then lost triangles: kept as it was, see
+/// docs/structures.md.)
+inline float distance_band(const vec3& v) {
+  return 1e-6f * (1.0f + glm::length(v));
 }
 
 /// Makes kept buffer v at least n long; it never shrinks, so once grown the call does nothing (its users
@@ -134,7 +134,7 @@ class ConvexCell {
     bool pos = false, neg = false;  // some vertex clearly above, clearly below
     for (size_t i = 0; i < verts_.size(); ++i) {
       dist[i] = p.distance(verts_[i]);
-      tol[i] = distance_band(verts_[i], p.d);
+      tol[i] = distance_band(verts_[i]);
       pos |= dist[i] > tol[i];
       neg |= dist[i] < -tol[i];
     }
@@ -148,10 +148,10 @@ class ConvexCell {
   ConvexCell side(const BspPlane& p, bool below, bool keeps, bool removes, const std::vector<float>& dist,
                   const std::vector<float>& tol) const {
     // No vertex clearly on this side: the part is a sliver within rounding of the plane, or nothing. It is
-    // asked for only when primitives were placed on this side (within the insertion margin, which may be
-    // wider than the rounding band), so it is the whole cell: a larger cell is conservative for the parts
-    // clipped to its box. (It was the empty cell, and those primitives lost their parts: an outside check
-    // found the bsp missing hits on a teapot scaled by 1e-5 or moved to 3e4.)
+    // asked for only when primitives were placed on this side (within the insertion margin), so it is the
+    // whole cell: a larger cell is conservative for the parts clipped to its box. (It was the empty cell,
+    // and those primitives lost their parts: an outside check found the bsp missing hits on a teapot moved
+    // to 3e4.)
     if (!keeps) return *this;
     if (!removes) return *this;
     if (const int a = exact_axis(p); box_ && a >= 0) {
@@ -223,7 +223,7 @@ class ConvexCell {
       if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) {
         const vec3 x = a + (da / (da - db)) * (b - a);
         out.push_back(x);
-        if (std::fabs(p.distance(x)) <= distance_band(x, p.d)) cut.push_back(x);
+        if (std::fabs(p.distance(x)) <= distance_band(x)) cut.push_back(x);
       }
     }
   }
@@ -274,7 +274,7 @@ class BoxSurface {
  public:
   /// The surface of box b.
   explicit BoxSurface(const AABB& b) : box_(b) {
-    for (const vec3& v : {b.lo, b.hi}) tol_ = std::max(tol_, distance_band(v, 0.0f));
+    for (const vec3& v : {b.lo, b.hi}) tol_ = std::max(tol_, distance_band(v));
   }
 
   /// Surface area.
@@ -339,7 +339,7 @@ class CellSurface {
       const std::span<const vec3> f = cell.face(k);
       for (size_t i = 2; i < f.size(); ++i) add(f[0], f[i - 1], f[i]);
     }
-    for (const vec3& v : cell.vertices()) tol_ = std::max(tol_, distance_band(v, 0.0f));
+    for (const vec3& v : cell.vertices()) tol_ = std::max(tol_, distance_band(v));
     padded_ = (count_ + kLanes - 1) / kLanes * kLanes;
     // Padding lanes: h0 = +inf and h2 = -inf (no part below any plane, and no effect on the extent),
     // zero area.
