@@ -147,13 +147,12 @@ class ConvexCell {
   /// The part on one side: `keeps` (some vertex clearly on that side), `removes` (some on the other).
   ConvexCell side(const BspPlane& p, bool below, bool keeps, bool removes, const std::vector<float>& dist,
                   const std::vector<float>& tol) const {
-    // No vertex clearly on this side: the part is a sliver within rounding of the plane, or nothing. It is
-    // asked for only when primitives were placed on this side (within the insertion margin), so it is the
-    // whole cell: a larger cell is conservative for the parts clipped to its box. (It was the empty cell,
-    // and those primitives lost their parts: an outside check found the bsp missing hits on a teapot moved
-    // to 3e4.)
-    if (!keeps) return *this;
-    if (!removes) return *this;
+    // No vertex clearly on the other side: the whole cell. No vertex clearly on this side: the part is a
+    // sliver within rounding of the plane, or nothing; it is asked for only when primitives were placed on
+    // this side (within the insertion margin), so it is the whole cell too, which is conservative for the
+    // parts clipped to its box. (It was the empty cell, and those primitives lost their parts: an outside
+    // check found the bsp missing hits on a teapot moved to 3e4.)
+    if (!keeps || !removes) return *this;
     if (const int a = exact_axis(p); box_ && a >= 0) {
       // A box cut by an axis plane is a box: the k-d tree's split of the box instead of a polyhedron clip.
       AABB b = bounds_;
