@@ -315,24 +315,31 @@ Mesh transformed(const Mesh& mesh, float scale, vec3 offset) {
 }
 
 TEST_P(Conformance, RaysFromHitPointsAndFarOrigins) {
-  // The outside check's smallest cases, each one triangle and one ray (brute's hit in the comment).
-  const Mesh one = one_triangle();
-  std::vector<Ray> exact = {
-      {{1.0f, 3.6915807e-08f, 1.1479106e-08f}, {0.34738958f, 0.64651322f, -0.67922097f}, 0.0f, kInf},
-      {{1.0f, -6.4549965e-09f, -1.5031716e-08f}, {26.261877f, 522.63513f, 612.48895f}, 0.0f, kInf},
-      {{0.25f, 0.25f, 1.0f}, {0.0f, 0.0f, -1.0f}, 0.0f, kInf}};  // and an ordinary hit
-  expect_same_as_brute(
-      *[&] {
-        auto a = make_accelerator(GetParam(), std::make_shared<const TrianglePrims>(share(one)), Params{});
-        a->build();
-        return a;
-      }(),
-      *[&] {
-        auto b = make_accelerator("brute", std::make_shared<const TrianglePrims>(share(one)), Params{});
-        b->build();
-        return b;
-      }(),
-      exact, "one triangle, hits outside its box by rounding");
+  // The outside check's smallest cases: one triangle hit just outside its box by rounding (and an ordinary
+  // hit), and four elongated triangles (4e4-7e5 long, 1e-3 thin) the bsp lost one of.
+  check_mesh(GetParam(), share(one_triangle()),
+             {{{1.0f, 3.6915807e-08f, 1.1479106e-08f}, {0.34738958f, 0.64651322f, -0.67922097f}, 0.0f, kInf},
+              {{1.0f, -6.4549965e-09f, -1.5031716e-08f}, {26.261877f, 522.63513f, 612.48895f}, 0.0f, kInf},
+              {{0.25f, 0.25f, 1.0f}, {0.0f, 0.0f, -1.0f}, 0.0f, kInf}},
+             "one triangle, hits outside its box by rounding");
+  Mesh elongated;
+  add_triangle(elongated, {263926.906f, 0.000636331097f, 0.00079860253f},
+               {263977.406f, 0.000640983344f, 0.000329054223f},
+               {263999.906f, 0.000303342415f, 0.000723590434f});
+  add_triangle(elongated, {738445.375f, 0.000668097346f, 6.00855783e-05f},
+               {738486.812f, 0.000864975504f, 0.00077214028f}, {738537.0f, 0.000961288693f, 0.000473855122f});
+  add_triangle(elongated, {361655.656f, 0.00027731029f, 0.00072183559f},
+               {361665.312f, 0.000923310232f, 1.01927099e-05f},
+               {361682.781f, 0.000636665092f, 0.000922433392f});
+  add_triangle(elongated, {40086.0938f, 9.84208873e-06f, 0.000335646153f},
+               {40106.2539f, 0.000490324921f, 0.000251173478f},
+               {40162.7969f, 0.000428018859f, 0.000776287867f});
+  check_mesh(GetParam(), share(elongated),
+             {{{0x1.39647p+15f, 0x1.739418p-13f, 0x1.a2bf1ep-12f},
+               {-0x1.c5a76cp-2f, 0x1.5c571ap-3f, 0x1.c2ad4cp-1f},
+               0.0f,
+               kInf}},
+             "elongated triangles");
   const std::filesystem::path dir = std::filesystem::path(ACCELBENCH_SOURCE_DIR) / ".." / "shared" / "meshes";
   Mesh base =
       std::filesystem::exists(dir / "teapot.obj") ? read_mesh((dir / "teapot.obj").string()) : nasty_mix();
