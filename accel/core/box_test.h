@@ -38,29 +38,6 @@ inline float widen_far(float t) {
   return t * (t > 0.0f ? 1.0f + kBoxEps : 1.0f - kBoxEps);
 }
 
-/// True when t lies in the ray's crossing of box b as every box walk computes it: the general path
-/// (slab_test's arithmetic, the binary walk's and the 8-wide walk's for tmin < 0) and, for tmin >= 0, the
-/// 8-wide walk's folded path (Bvh8RayTest: the widening folded into the reciprocals). Both are monotone in
-/// the box (a larger box gives each bound the same or a wider value, bit for bit), so a t that passes for a
-/// triangle's box passes for every box that holds it: the kernel's acceptance (intersect_triangle) asks
-/// this of the triangle's own box, and every BVH then enters each node on the way to that triangle.
-inline bool within_box_crossing(const Ray& ray, const AABB& b, float t) {
-  const RayBoxData r(ray);
-  float tn = -kInf, tf = kInf, fn = -kInf, ff = kInf;  // general, and folded, near and far
-  for (int a = 0; a < 3; ++a) {
-    const float dn = (r.neg[a] ? b.hi[a] : b.lo[a]) - r.org[a];
-    const float df = (r.neg[a] ? b.lo[a] : b.hi[a]) - r.org[a];
-    const float n = dn * r.inv_dir[a], f = df * r.inv_dir[a];
-    tn = n > tn ? n : tn;  // a NaN distance keeps the bound, as in every walk
-    tf = f < tf ? f : tf;
-    const float n2 = dn * (r.inv_dir[a] * (1.0f - kBoxEps)), f2 = df * (r.inv_dir[a] * (1.0f + kBoxEps));
-    fn = n2 > fn ? n2 : fn;
-    ff = f2 < ff ? f2 : ff;
-  }
-  if (!(widen_near(tn) <= t && t <= widen_far(tf))) return false;
-  return ray.tmin < 0.0f || (fn <= t && t <= ff);
-}
-
 /// Clips [t0, t1] against box b. Returns false when the ray misses it within that interval.
 /// On return [t0, t1] is the (conservatively widened) overlap. The near plane per axis is chosen by
 /// the direction's sign, and comparisons keep the current bound when a slab distance is NaN
@@ -75,6 +52,29 @@ inline bool slab_test(const AABB& b, const RayBoxData& r, float& t0, float& t1) 
     t1 = tf < t1 ? tf : t1;
   }
   return t0 <= t1;
+}
+
+/// True when t lies in the ray's crossing of box b as every box walk computes it: the general path
+/// (slab_test: the binary walk's arithmetic, and the 8-wide walk's for tmin < 0; widening each axis's
+/// distance or their reduction is the same, widen_near and widen_far being monotone) and, for tmin >= 0,
+/// the 8-wide walk's folded path (Bvh8RayTest: the widening folded into the reciprocals). Both are monotone
+/// in the box (a larger box gives each bound the same or a wider value, bit for bit), so a t that passes for
+/// a triangle's box passes for every box that holds it: the kernel's acceptance (intersect_triangle) asks
+/// this of the triangle's own box, and every BVH then enters each node on the way to that triangle.
+inline bool within_box_crossing(const Ray& ray, const AABB& b, float t) {
+  const RayBoxData r(ray);
+  float t0 = -kInf, t1 = kInf;
+  if (!slab_test(b, r, t0, t1) || !(t0 <= t && t <= t1)) return false;
+  if (ray.tmin < 0.0f) return true;
+  float fn = -kInf, ff = kInf;
+  for (int a = 0; a < 3; ++a) {
+    const float dn = (r.neg[a] ? b.hi[a] : b.lo[a]) - r.org[a];
+    const float df = (r.neg[a] ? b.lo[a] : b.hi[a]) - r.org[a];
+    const float n = dn * (r.inv_dir[a] * (1.0f - kBoxEps)), f = df * (r.inv_dir[a] * (1.0f + kBoxEps));
+    fn = n > fn ? n : fn;  // a NaN distance keeps the bound, as in every walk
+    ff = f < ff ? f : ff;
+  }
+  return fn <= t && t <= ff;
 }
 
 }  // namespace ab

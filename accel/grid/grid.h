@@ -205,6 +205,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     GridConfig config = config_;
     for (;;) {
       layout_ = make_grid_layout(prims_->bounds(), n, config);
+      reach_ = reach_of(layout_.box);
       insert_all(n, max_refs);
       if (!cells_.over_budget) break;
       config.lambda *= 0.5;
@@ -244,11 +245,14 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   /// every primitive, as brute does (found by an outside check: from 1e7 away, every plane of a unit grid
   /// lies within one ulp of the origin's coordinates, and the walk took cells the kernel's hit was not in).
   bool far_origin(const Ray& ray) const {
-    const vec3 e = layout_.box.extent();
-    const vec3 a = glm::max(glm::abs(layout_.box.lo), glm::abs(layout_.box.hi));
-    const float reach = 0x1p5f * std::max({e.x, e.y, e.z, a.x, a.y, a.z});
     const vec3 o = glm::abs(ray.org);
-    return !(std::max({o.x, o.y, o.z}) <= reach);
+    return !(std::max({o.x, o.y, o.z}) <= reach_);
+  }
+  /// 2^5 times the grid box's largest extent or coordinate (far_origin), made with the layout.
+  static float reach_of(const AABB& box) {
+    const vec3 e = box.extent();
+    const vec3 a = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+    return 0x1p5f * std::max({e.x, e.y, e.z, a.x, a.y, a.z});
   }
   /// Calls f(id) for each primitive of the walk's current cell not yet tested for this ray; stops early
   /// when f returns true (f may return void).
@@ -277,6 +281,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   std::shared_ptr<const P> prims_;
   GridConfig config_;
   GridLayout layout_;
+  float reach_ = 0.0f;  ///< far_origin's bound (reach_of the layout's box)
   GridCells cells_;
 };
 
