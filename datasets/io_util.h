@@ -4,10 +4,13 @@
 
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <istream>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -41,13 +44,23 @@ inline void put_le32(std::string& buffer, T value) {
 }
 
 /// Parses a whole token as a float (from_chars: locale-independent, accepts nan/inf, which the
-/// callers reject separately), or throws naming the file and line.
+/// callers reject separately), or throws naming the file and line. A number beyond the float range is
+/// refused as such; one below it (1e-50) rounds to zero or a denormal, as the text's nearest float.
 inline float parse_float(std::string_view token, const std::string& path, size_t line) {
   float f = 0.0f;
-  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), f);
-  if (token.empty() || ec != std::errc() || end != token.data() + token.size())
-    throw InputError(path + ":" + std::to_string(line) + ": '" + std::string(token) + "' is not a number");
-  return f;
+  const char* last = token.data() + token.size();
+  const auto [end, ec] = std::from_chars(token.data(), last, f);
+  auto refuse = [&](const char* why) {
+    return InputError(path + ":" + std::to_string(line) + ": '" + std::string(token) + "' " + why);
+  };
+  if (token.empty() || end != last || (ec != std::errc() && ec != std::errc::result_out_of_range))
+    throw refuse("is not a number");
+  if (ec == std::errc()) return f;
+  // Out of the float range (from_chars leaves f): the nearest double (strtod, the program's "C" locale,
+  // on text from_chars accepted) tells too large from too small.
+  const double d = std::strtod(std::string(token).c_str(), nullptr);
+  if (std::abs(d) <= double(std::numeric_limits<float>::max())) return float(d);
+  throw refuse("is beyond the range of a 32-bit float");
 }
 
 /// Splits off the next whitespace-separated token of `rest` ("" at the end).

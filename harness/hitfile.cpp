@@ -88,8 +88,9 @@ std::vector<Ray> read_rays(const std::string& path) {
   }
   for (size_t i = 0; i < rays.size(); ++i) {
     const Ray& r = rays[i];
-    if (!finite3(r.org) || !finite3(r.dir) || !std::isfinite(r.tmin) || std::isnan(r.tmax))
-      throw InputError(path + ": ray " + std::to_string(i) + " has a NaN or infinite value");
+    if (!finite3(r.org) || !finite3(r.dir) || !std::isfinite(r.tmin) || !(r.tmax > -kInf))
+      throw InputError(path + ": ray " + std::to_string(i) +
+                       " has a NaN or infinite value (only tmax may be +inf)");
     if (!(r.time >= 0.0f && r.time <= 1.0f))
       throw InputError(path + ": ray " + std::to_string(i) + " has time " + std::to_string(r.time) +
                        " (NaN or outside [0, 1])");

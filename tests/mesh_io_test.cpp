@@ -277,6 +277,21 @@ TEST_F(MeshIoTest, NonFiniteCoordinates) {
                      "NaN or infinite");
 }
 
+TEST_F(MeshIoTest, NumbersBeyondTheFloatRange) {
+  // Too large for a float: refused as such (it was "not a number"); too small: the nearest float, zero.
+  expect_input_error(write("big.obj", "v 0 0 0\nv 1e39 1 0\nv 0 1 0\nf 1 2 3\n"),
+                     "'1e39' is beyond the range of a 32-bit float");
+  expect_input_error(write("big.stl",
+                           "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex -4e38 0 0\n"
+                           "vertex 0 1 0\nendloop\nendfacet\nendsolid x\n"),
+                     "beyond the range");
+  const Mesh m = read_mesh(write("tiny.obj", "v 0 0 0\nv 1 1e-50 0\nv 0 1 -1e-400\nf 1 2 3\n"));
+  ASSERT_EQ(m.vertices.size(), 3u);
+  EXPECT_EQ(m.vertices[1].y, 0.0f);
+  EXPECT_EQ(m.vertices[2].z, 0.0f);
+  EXPECT_EQ(m.vertices[1].x, 1.0f);
+}
+
 TEST_F(MeshIoTest, IndexOutOfRange) {
   expect_input_error(write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n"), "vertex");
   expect_input_error(write("bad.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 7\n"), "vertex");

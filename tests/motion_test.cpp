@@ -154,6 +154,29 @@ TEST(MotionRayFile, BadTimesAreBadInput) {
   }
 }
 
+TEST(MotionRayFile, OnlyTmaxMayBeInfiniteAndOnlyPlusInfinity) {
+  // The contract: "tmax may be +inf"; -inf there (every ray an empty interval) is bad input like tmin's.
+  for (RayFileVersion version : {RayFileVersion::kV1, RayFileVersion::kV2}) {
+    std::vector<Ray> rays(3);
+    rays[0].tmax = kInf;
+    const fs::path p = temp_path("tmax.rays");
+    write_rays(p.string(), rays, version);
+    EXPECT_EQ(read_rays(p.string()).size(), 3u);
+    for (int field : {0, 1}) {
+      std::vector<Ray> bad = rays;
+      (field == 0 ? bad[2].tmax : bad[2].tmin) = -kInf;
+      write_rays(p.string(), bad, version);
+      try {
+        read_rays(p.string());
+        ADD_FAILURE() << (field == 0 ? "tmax" : "tmin") << " = -inf was accepted";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("ray 2"), std::string::npos) << e.what();
+      }
+    }
+    fs::remove(p);
+  }
+}
+
 TEST(MotionPrims, InterpolationHitsTheStepsAndStaysInsideTheSweptBox) {
   const Mesh base = soup(200, 5);
   const auto steps = deforming_steps(base, 4, 0.3f, 6);
