@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <span>
 #include <utility>
 #include <vector>
@@ -468,10 +469,20 @@ class CellSurface {
     highest_ = *std::max_element(hi.begin(), hi.end());
   }
 
+  /// kLanes floats as one value (GCC's vector extension, lowered to the target's vectors): the area
+  /// profile's per-lane sums stay in registers from block to block (as arrays they went through memory
+  /// every block, behind a run-time aliasing check), with the same operations in every lane as before.
+  using Lanes = float __attribute__((vector_size(16 * sizeof(float))));
+
   /// The per-lane sums of the surface's area below d and of the cut face's share (kLanes each, into out),
-  /// over kLanes triangles at a time (one accumulator per lane: the loop over the lanes is vectorized).
+  /// over kLanes triangles at a time (one accumulator per lane).
   void area_below(float d, float* __restrict out) const {
-    std::array<float, kLanes> b{}, c{};
+    static_assert(sizeof(Lanes) == kLanes * sizeof(float));
+    Lanes b{}, c{}, at{}, one{};
+    for (size_t l = 0; l < kLanes; ++l) {
+      at[l] = d;
+      one[l] = 1.0f;
+    }
     const size_t padded = padded_;
     const float *h0 = heights_.data(), *h1 = h0 + padded, *h2 = h1 + padded, *il = h2 + padded;
     const float *ih = il + padded, *area = ih + padded, *weighted = area + padded;
@@ -479,19 +490,25 @@ class CellSurface {
       // A block whose triangles all start at or above d adds zero to every lane (exactly: no lane's sum
       // is ever -0), so it is skipped; block_low_ is its lowest h0.
       if (!(d > block_low_[i / kLanes])) continue;
-      for (size_t l = 0; l < kLanes; ++l) {
-        // The fraction of the triangle's area below d, without branches (the reciprocal of a zero
-        // denominator, and a padding lane's, is only ever in a lane the selects discard).
-        const float lo = d - h0[i + l], hi = h2[i + l] - d;
-        float f = d < h1[i + l] ? lo * lo * il[i + l] : 1.0f - hi * hi * ih[i + l];
-        f = d > h0[i + l] ? f : 0.0f;
-        f = d < h2[i + l] ? f : (d > h0[i + l] ? 1.0f : 0.0f);
-        b[l] += area[i + l] * f;
-        c[l] += weighted[i + l] * f;
-      }
+      Lanes v0, v1, v2, vl, vh, va, vw;
+      std::memcpy(&v0, h0 + i, sizeof(Lanes));
+      std::memcpy(&v1, h1 + i, sizeof(Lanes));
+      std::memcpy(&v2, h2 + i, sizeof(Lanes));
+      std::memcpy(&vl, il + i, sizeof(Lanes));
+      std::memcpy(&vh, ih + i, sizeof(Lanes));
+      std::memcpy(&va, area + i, sizeof(Lanes));
+      std::memcpy(&vw, weighted + i, sizeof(Lanes));
+      // The fraction of each triangle's area below d, without branches (the reciprocal of a zero
+      // denominator, and a padding lane's, is only ever in a lane the selects discard).
+      const Lanes lo = at - v0, hi = v2 - at;
+      Lanes f = at < v1 ? lo * lo * vl : one - hi * hi * vh;
+      f = at > v0 ? f : Lanes{};
+      f = at < v2 ? f : (at > v0 ? one : Lanes{});
+      b += va * f;
+      c += vw * f;
     }
-    std::copy(b.begin(), b.end(), out);
-    std::copy(c.begin(), c.end(), out + kLanes);
+    std::memcpy(out, &b, sizeof(Lanes));
+    std::memcpy(out + kLanes, &c, sizeof(Lanes));
   }
   static constexpr size_t kLanes = 16, kFields = 7;
 
