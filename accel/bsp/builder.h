@@ -77,13 +77,16 @@ class BspBuilder {
   /// primitives from being duplicated into every cell their supporting line or plane crosses.
   struct NodePrims {
     std::vector<uint32_t> ids;
-    std::vector<uint32_t> start{0};
+    /// Primitive k's points are pts[start[k], start[k + 1]); empty while no primitive is added, so an empty
+    /// set (the children a split starts with, a node's set once it is split) allocates nothing.
+    std::vector<uint32_t> start;
     std::vector<vec3> pts;
     size_t size() const { return ids.size(); }
-    /// Appends primitive id with its k support points.
+    /// Appends primitive id with its k support points (one at a time: a range insert took the generic path).
     void add(uint32_t id, const vec3* p, int k) {
+      if (start.empty()) start.push_back(0);
       ids.push_back(id);
-      pts.insert(pts.end(), p, p + k);
+      for (int j = 0; j < k; ++j) pts.push_back(p[j]);
       start.push_back(uint32_t(pts.size()));
     }
   };
@@ -180,8 +183,10 @@ class BspBuilder {
         ++count;
         points += np.start[k + 1] - np.start[k];
       }
+    if (count == 0) return out;
     out.ids.reserve(count);  // one allocation each (a clip adds a point or two per cut part)
     out.start.reserve(count + 1);
+    out.start.push_back(0);
     out.pts.reserve(points + 2 * count);
     vec3 buf[kMaxSupportPoints];
     for (size_t k = 0; k < np.size(); ++k) {
