@@ -790,10 +790,13 @@ class BspBuilder {
     thread_local std::vector<float> x;  // used only here: no call below builds a node
     thread_local std::vector<uint32_t> l, r;
     const size_t count = d.size() - first, padded = (count + kCountLanes - 1) / kCountLanes * kCountLanes;
-    x.assign(padded, 0.0f);
+    grow_buffer(x, padded);  // kept buffers filled in place (assign was a call per node that rarely grew)
+    grow_buffer(l, padded);
+    grow_buffer(r, padded);
     std::copy(d.begin() + ptrdiff_t(first), d.end(), x.begin());
-    l.assign(padded, 0);
-    r.assign(padded, 0);
+    std::fill(x.begin() + ptrdiff_t(count), x.begin() + ptrdiff_t(padded), 0.0f);
+    std::fill_n(l.begin(), padded, 0u);
+    std::fill_n(r.begin(), padded, 0u);
     const float half = 0.5f * margin_;
     for (size_t i = 0; i < n; ++i) {
       const float a = lo[i], b = hi[i];
@@ -816,8 +819,10 @@ class BspBuilder {
                          std::vector<uint32_t>& nr) const {
     const int bins = config_.bins;
     std::vector<uint32_t>&starts = s.starts, &ends = s.ends;
-    starts.assign(size_t(bins), 0);
-    ends.assign(size_t(bins), 0);
+    grow_buffer(starts, size_t(bins));
+    grow_buffer(ends, size_t(bins));
+    std::fill_n(starts.begin(), bins, 0u);
+    std::fill_n(ends.begin(), bins, 0u);
     const float scale = float(bins) / (range_hi - range_lo);
     for (size_t i = 0; i < n; ++i) {
       ++starts[std::clamp(int((lo[i] - range_lo) * scale), 0, bins - 1)];
