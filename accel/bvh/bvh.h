@@ -79,7 +79,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     const auto limit = [&] { return std::min(ray.tmax, best.t); };
     if (config_.width == 8) {
       if (wide_.empty()) return;
-      const LeafRay leaf_ray(ray);
+      LeafRay leaf_ray(ray);
       const auto leaf = [&](uint32_t first, uint32_t count) {
         return wide_leaf<kCount, false>(first, count, ray, leaf_ray, &best, inst, c);
       };
@@ -103,7 +103,7 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     const auto limit = [&] { return ray.tmax; };
     if (config_.width == 8) {
       if (wide_.empty()) return false;
-      const LeafRay leaf_ray(ray);
+      LeafRay leaf_ray(ray);
       const auto leaf = [&](uint32_t first, uint32_t count) {
         return wide_leaf<kCount, true>(first, count, ray, leaf_ray, nullptr, 0, c);
       };
@@ -282,14 +282,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
 
   /// Tests a wide leaf (`first`, `count` as stored in its lane): triangle blocks four at a time with the
   /// one kernel, other primitives one by one. kAny: returns true at the first hit; otherwise updates *best
-  /// and returns false.
+  /// and returns false. The closest-hit search lowers leaf_ray's tmax to the best hit's t (Ray4::set_tmax).
   template <bool kCount, bool kAny>
-  [[gnu::always_inline]] bool wide_leaf(uint32_t first, uint32_t count, const Ray& ray,
-                                        const LeafRay& leaf_ray, Hit* best, uint32_t inst,
-                                        RayCounters& c) const {
+  [[gnu::always_inline]] bool wide_leaf(uint32_t first, uint32_t count, const Ray& ray, LeafRay& leaf_ray,
+                                        Hit* best, uint32_t inst, RayCounters& c) const {
     if constexpr (kCopiesTriangles) {
       if constexpr (kCount) c.prims += count;
       for (uint32_t b = first, e = first + (count + 3) / 4; b < e; ++b) {
+        if constexpr (!kAny) leaf_ray.set_tmax(best->t);
         alignas(16) float t[4], u[4], v[4];
         unsigned mask = intersect_triangle4(leaf_ray, blocks_.blocks[b], t, u, v);
         if constexpr (kAny) {

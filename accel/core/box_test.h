@@ -60,9 +60,9 @@ inline bool slab_test(const AABB& b, const RayBoxData& r, float& t0, float& t1) 
 /// the 8-wide walk's folded path (Bvh8RayTest: the widening folded into the reciprocals). Both are monotone
 /// in the box (a larger box gives each bound the same or a wider value, bit for bit), so a t that passes for
 /// a triangle's box passes for every box that holds it: the kernel's acceptance (intersect_triangle) asks
-/// this of the triangle's own box, and every BVH then enters each node on the way to that triangle.
-inline bool within_box_crossing(const Ray& ray, const AABB& b, float t) {
-  const RayBoxData r(ray);
+/// this of the triangle's own box, and every BVH then enters each node on the way to that triangle. r is
+/// RayBoxData(ray), which a caller testing many hits of one ray makes once.
+inline bool within_box_crossing(const Ray& ray, const RayBoxData& r, const AABB& b, float t) {
   float t0 = -kInf, t1 = kInf;
   if (!slab_test(b, r, t0, t1) || !(t0 <= t && t <= t1)) return false;
   if (ray.tmin < 0.0f) return true;
@@ -75,6 +75,11 @@ inline bool within_box_crossing(const Ray& ray, const AABB& b, float t) {
     ff = f < ff ? f : ff;
   }
   return fn <= t && t <= ff;
+}
+
+/// within_box_crossing with the ray's box data made here (the same reciprocals as the walks').
+inline bool within_box_crossing(const Ray& ray, const AABB& b, float t) {
+  return within_box_crossing(ray, RayBoxData(ray), b, t);
 }
 
 }  // namespace ab

@@ -170,15 +170,18 @@ inline AABB kernel_box(const Vec3T<float>& v0, const Vec3T<float>& e1, const Vec
 /// triangle, and so outside its box: a ray starting on the surface (t near 0, where the walks' relative
 /// widening is nothing) or leaving it past a vertex. Such a hit was found by brute but not by a structure
 /// that pruned the box; with this rule every structure and brute accept the same hits.
-inline bool kernel_hit_in_box(const Ray& ray, const TriangleTerms<float>& terms, float t) {
-  return within_box_crossing(ray, kernel_box(terms.v0, terms.e1, terms.e2), t);
+/// r is RayBoxData(ray), made once per ray by the caller.
+inline bool kernel_hit_in_box(const Ray& ray, const RayBoxData& r, const TriangleTerms<float>& terms,
+                              float t) {
+  return within_box_crossing(ray, r, kernel_box(terms.v0, terms.e1, terms.e2), t);
 }
 /// kernel_hit_in_box of triangle tri, its terms made again (the same operations, so the same box). Kept out
 /// of line, from the triangle rather than the kernel's terms: it runs only on a kernel hit (about one a
 /// ray), and inlined on the terms it kept them live across the kernel, which then spilled them on its
 /// common path, the miss (the grid's closest-hit walk 105.7M -> 124.2M instructions; 106.1M now).
 [[gnu::noinline]] inline bool kernel_hit_in_box(const Ray& ray, const Triangle& tri, float t) {
-  return kernel_hit_in_box(ray, triangle_terms(to_lanes(tri.v0), to_lanes(tri.v1), to_lanes(tri.v2)), t);
+  return kernel_hit_in_box(ray, RayBoxData(ray),
+                           triangle_terms(to_lanes(tri.v0), to_lanes(tri.v1), to_lanes(tri.v2)), t);
 }
 
 /// The kernel for one triangle, with its acceptance (kernel_hit_in_box). Returns true and fills out on a

@@ -152,7 +152,9 @@ class Grid final : public AcceleratorBase<Grid<P>> {
 
   /// Closest hit: walks the cells in ray order and stops once the best hit lies before the current
   /// cell's exit (best.t < the exit distance widened towards the origin), so a primitive in a later cell,
-  /// which lies beyond that plane by more than the insertion margin, can neither beat nor tie it.
+  /// which lies beyond that plane by more than the insertion margin, can neither beat nor tie it. The
+  /// primitives are tested on a copy of the ray whose tmax follows best.t, as in the trees' leaves
+  /// (intersect_id_list): the same hits, and a hit beyond the best skips the kernel's acceptance check.
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
     if (cells_.ids.empty()) return;
@@ -165,9 +167,12 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     if (!slab_test(layout_.box, rd, t0, t1)) return;
     GridWalk walk(layout_, ray, rd, t0);
     Mailbox mailbox;
+    Ray r = ray;
+    r.tmax = std::min(ray.tmax, best.t);
     for (;;) {
-      visit_cell<kCount>(walk, mailbox, c,
-                         [&](uint32_t id) { prims_->template intersect<kCount>(id, ray, best, inst, c); });
+      visit_cell<kCount>(walk, mailbox, c, [&](uint32_t id) {
+        if (prims_->template intersect<kCount>(id, r, best, inst, c)) r.tmax = std::min(ray.tmax, best.t);
+      });
       const float t_exit = widen_near(walk.exit());
       if (best.t < t_exit || t_exit > t1 || !walk.advance(layout_, rd)) return;
     }
