@@ -88,6 +88,9 @@ void frame(const vec3& a, vec3& t, vec3& b) {
 // spheres of a third of its radius touching it, six around its equator and three above, recursively,
 // each child oriented along the direction from its parent.
 void add_flake(Flake& f, const vec3& center, float radius, const vec3& axis, int depth) {
+  // A given depth may ask for far more spheres than the count needs (depth 7: 5.4M spheres of at
+  // least 6 triangles); finish() keeps a prefix, so nothing is emitted past the target.
+  if (f.out.triangles() >= f.target) return;
   const double budget = static_cast<double>(f.target - std::min(f.target, f.out.triangles())) /
                         static_cast<double>(f.spheres_left);
   add_sphere_budget(f.out, center, radius, budget, f.spheres_left == 1);
@@ -187,6 +190,7 @@ Mesh make_terrain(uint64_t triangles, uint64_t seed, Params& params) {
 /// Sierpinski tetrahedron state: where leaves go and how many of them are refined once more.
 struct Tetra {
   MeshBuilder& out;
+  uint64_t target;  ///< triangles wanted: finish() keeps a prefix, so nothing is emitted past it
   uint64_t refine;  ///< leaves (in emission order) that are subdivided once more
   uint64_t leaf = 0;
 };
@@ -217,6 +221,7 @@ void split_tetrahedron(const vec3& a, const vec3& b, const vec3& c, const vec3& 
 // can fall between powers of four.
 void add_tetra(Tetra& t, const vec3& a, const vec3& b, const vec3& c, const vec3& d, int depth) {
   vec3 child[4][4];
+  if (t.out.triangles() >= t.target) return;
   if (depth == 0 && t.leaf++ >= t.refine) {
     add_tetrahedron(t.out, a, b, c, d);
     return;
@@ -239,8 +244,9 @@ Mesh make_tetra(uint64_t triangles, uint64_t /*seed*/, Params& params) {
   }
   const uint64_t base = 4ull << (2 * depth);
   const uint64_t refine = given < 0 && triangles > base ? (triangles - base + 11) / 12 : 0;
-  MeshBuilder out(base + 12 * refine, base + 12 * refine);
-  Tetra t{out, refine};
+  const uint64_t reserve = std::min(triangles, base + 12 * refine);
+  MeshBuilder out(reserve, reserve);
+  Tetra t{out, triangles, refine};
   add_tetra(t, vec3(1, 1, 1), vec3(-1, -1, 1), vec3(-1, 1, -1), vec3(1, -1, -1), depth);
   return out.finish(triangles);
 }

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "accel/core/error.h"
+#include "accel/core/memory.h"
 
 namespace ab {
 namespace {
@@ -92,6 +93,20 @@ TEST(Generators, ParametersChangeTheMesh) {
   const Mesh deep = generate_mesh("sphereflake", 5000, 0, with({{"depth", "2"}}));
   EXPECT_LT(flat.bounds().extent().x, deep.bounds().extent().x);
   EXPECT_EQ(deep.size(), 5000u);
+}
+
+// Found by fuzzing the scene reader (a sphereflake of 200 triangles at depth 7 took over 10 s): a given
+// depth asks for millions of spheres or tetrahedra, but the work stays bounded by the triangle count.
+TEST(Generators, AGivenDepthDoesNotOutgrowTheCount) {
+  for (const auto& [name, depth] : {std::pair{"sphereflake", "7"}, {"stadium", "7"}, {"tetra", "13"}}) {
+    const HeapPeak peak;
+    const Mesh m = generate_mesh(name, 200, 1, with({{"depth", depth}}));
+    EXPECT_EQ(m.size(), 200u) << name;
+    expect_valid(m, name);
+    if (heap_accounting_enabled()) {
+      EXPECT_LT(peak.bytes(), 1u << 20) << name;
+    }
+  }
 }
 
 TEST(Generators, CityscapeHasLatticeCoordinatesDuplicatesAndDegenerates) {
