@@ -56,9 +56,10 @@ class BspBuilder {
       set_gain_floor(box, ids.size());
       count_frontier_root(ledger, root.size());
       if (ledger && config_.reuse_decisions)
-        build_top(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, out);
+        build_top(std::move(root), ConvexCell::from_box(box, band_floor(box)), Depth{0, 0, 0, budget}, out);
       else
-        build_node(std::move(root), ConvexCell::from_box(box), Depth{0, 0, 0, budget}, 0, out);
+        build_node(std::move(root), ConvexCell::from_box(box, band_floor(box)), Depth{0, 0, 0, budget}, 0,
+                   out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;
@@ -275,7 +276,7 @@ class BspBuilder {
   /// (1 - empty_bonus) x traversal) is a leaf without pricing its planes. The floor is ours (measured in
   /// docs/structures.md), on the expected-cost model of the papers above.
   void set_gain_floor(const AABB& box, size_t n) const {
-    root_area_ = ConvexCell::from_box(box).area();
+    root_area_ = ConvexCell::from_box(box, band_floor(box)).area();
     gain_floor_ = config_.min_gain / float(std::max<size_t>(n, 1));
   }
   /// The node's share of the rays, area(cell) / area(root), when the minimum-gain rule applies to it (at
@@ -658,7 +659,7 @@ class BspBuilder {
     PlaneScratch own;
     PlaneScratch& scratch = np.size() <= kKeptScratchMax ? kept : own;
     if (large && cell.is_box()) {  // a box cell cut by axis planes: the k-d tree's closed-form areas
-      const BoxSurface box(cell.bounds());
+      const BoxSurface box(cell);
       const float area = box.area();
       if (!(area > 0.0f)) return ch;
       for (size_t i = 0; i < 3; ++i)

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -17,12 +18,25 @@
 
 namespace ab {
 
-/// The rounding band of a vertex's signed distance from a plane: 1e-6 of 1 + |v|. (Its absolute floor is
-/// 3 % of a teapot scaled by 1e-5; a band relative to |v| alone, or to the root's magnitude, was too tight
-/// for the clipper on the bunny scaled by 1e-5, which then lost triangles: kept as it was, see
-/// docs/structures.md.)
-inline float distance_band(const vec3& v) {
-  return 1e-6f * (1.0f + glm::length(v));
+/// The rounding band of a vertex's signed distance from a plane: 1e-6 of floor + |v|, where floor is the
+/// root cell's magnitude up to 1 (band_floor). An absolute floor of 1 was 3 % of a teapot scaled by 1e-5:
+/// planes cutting such a cell were taken for no cut, cut faces' points merged (near_duplicate), and the
+/// cells lost triangles of the teapot at 1e-5 and of the bunny at 1e-2 to 1e-4 (docs/structures.md).
+inline float distance_band(const vec3& v, float floor) {
+  return 1e-6f * (floor + glm::length(v));
+}
+
+/// The distance within which two points of a cut face are one (a tenth of distance_band).
+inline float near_duplicate(const vec3& v, float floor) {
+  return 1e-7f * (floor + glm::length(v));
+}
+
+/// The bands' absolute floor for a tree whose root cell is box b: its largest coordinate magnitude, at
+/// most 1 (so a mesh of unit size or larger keeps the floor 1) and at least the smallest normal float.
+inline float band_floor(const AABB& b) {
+  const vec3 m = glm::max(glm::abs(b.lo), glm::abs(b.hi));
+  const float mag = std::max({m.x, m.y, m.z});
+  return mag >= 1.0f || !(mag == mag) ? 1.0f : std::max(mag, std::numeric_limits<float>::min());
 }
 
 /// Makes kept buffer v at least n long; it never shrinks, so once grown the call does nothing (its users
@@ -36,9 +50,11 @@ inline void grow_buffer(std::vector<T>& v, size_t n) {
 /// in one flat array of vertices with each face's first index (two allocations per cell, not one per face).
 class ConvexCell {
  public:
-  /// The six faces of box b.
-  static ConvexCell from_box(const AABB& b) {
+  /// The six faces of box b, whose rounding bands have absolute floor `floor` (band_floor of the root's
+  /// box; inherited by every part).
+  static ConvexCell from_box(const AABB& b, float floor) {
     ConvexCell c;
+    c.floor_ = floor;
     if (b.empty()) return c;
     auto corner = [&](int k) {
       return vec3((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
@@ -56,6 +72,9 @@ class ConvexCell {
     c.bounds_ = b;
     return c;
   }
+
+  /// The rounding bands' absolute floor (from_box).
+  float floor() const { return floor_; }
 
   /// True when the cell is its bounding box (the root's, cut by axis planes only).
   bool is_box() const { return box_; }
@@ -135,7 +154,7 @@ class ConvexCell {
     bool pos = false, neg = false;  // some vertex clearly above, clearly below
     for (size_t i = 0; i < verts_.size(); ++i) {
       dist[i] = p.distance(verts_[i]);
-      tol[i] = distance_band(verts_[i]);
+      tol[i] = distance_band(verts_[i], floor_);
       pos |= dist[i] > tol[i];
       neg |= dist[i] < -tol[i];
     }
@@ -158,9 +177,10 @@ class ConvexCell {
       // A box cut by an axis plane is a box: the k-d tree's split of the box instead of a polyhedron clip.
       AABB b = bounds_;
       (below ? b.hi : b.lo)[a] = p.d;
-      return from_box(b);
+      return from_box(b, floor_);
     }
     ConvexCell out;
+    out.floor_ = floor_;
     out.verts_.reserve(verts_.size() + 8);
     out.starts_.reserve(face_count() + 2);
     out.starts_.push_back(0);
@@ -176,7 +196,7 @@ class ConvexCell {
         out.verts_.resize(first);
     }
     if (cut.size() >= 3) {
-      order_cut(cut, below ? p.n : -p.n, out.verts_);
+      order_cut(cut, below ? p.n : -p.n, floor_, out.verts_);
       out.starts_.push_back(uint32_t(out.verts_.size()));
     }
     for (const vec3& v : out.verts_) out.bounds_.extend(v);
@@ -223,14 +243,14 @@ class ConvexCell {
       if ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)) {
         const vec3 x = a + (da / (da - db)) * (b - a);
         out.push_back(x);
-        if (std::fabs(p.distance(x)) <= distance_band(x)) cut.push_back(x);
+        if (std::fabs(p.distance(x)) <= distance_band(x, floor_)) cut.push_back(x);
       }
     }
   }
 
   /// Appends the cut face's vertices pts, without near-duplicates, in counter-clockwise order around
   /// outward normal n.
-  static void order_cut(std::vector<vec3>& pts, const vec3& n, std::vector<vec3>& out) {
+  static void order_cut(std::vector<vec3>& pts, const vec3& n, float floor, std::vector<vec3>& out) {
     vec3 c(0.0f);
     for (const vec3& v : pts) c += v;
     c /= float(pts.size());
@@ -252,10 +272,10 @@ class ConvexCell {
     const size_t first = out.size();
     for (const auto& [key, i] : keys)
       if (const vec3& v = pts[i];
-          out.size() == first || glm::length(v - out.back()) > 1e-7f * (1.0f + glm::length(v)))
+          out.size() == first || glm::length(v - out.back()) > near_duplicate(v, floor))
         out.push_back(v);
     while (out.size() > first + 1 &&
-           glm::length(out[first] - out.back()) <= 1e-7f * (1.0f + glm::length(out.back())))
+           glm::length(out[first] - out.back()) <= near_duplicate(out.back(), floor))
       out.pop_back();
   }
 
@@ -263,8 +283,9 @@ class ConvexCell {
   /// Face k is verts_[starts_[k], starts_[k + 1]); empty for an empty cell (no allocation for the empty
   /// cells a split's parts start as).
   std::vector<uint32_t> starts_;
-  AABB bounds_;       ///< bounds of verts_
-  bool box_ = false;  ///< the faces are those of an axis-aligned box (from_box)
+  AABB bounds_;         ///< bounds of verts_
+  bool box_ = false;    ///< the faces are those of an axis-aligned box (from_box)
+  float floor_ = 1.0f;  ///< the rounding bands' absolute floor (from_box)
 };
 
 /// The areas of a box cell cut by axis planes, in closed form (the k-d tree's SAH areas): the same
@@ -272,9 +293,9 @@ class ConvexCell {
 /// whose cells are boxes, without triangulating the cell's surface.
 class BoxSurface {
  public:
-  /// The surface of box b.
-  explicit BoxSurface(const AABB& b) : box_(b) {
-    for (const vec3& v : {b.lo, b.hi}) tol_ = std::max(tol_, distance_band(v));
+  /// The surface of box cell c.
+  explicit BoxSurface(const ConvexCell& c) : box_(c.bounds()) {
+    for (const vec3& v : {box_.lo, box_.hi}) tol_ = std::max(tol_, distance_band(v, c.floor()));
   }
 
   /// Surface area.
@@ -339,7 +360,7 @@ class CellSurface {
       const std::span<const vec3> f = cell.face(k);
       for (size_t i = 2; i < f.size(); ++i) add(f[0], f[i - 1], f[i]);
     }
-    for (const vec3& v : cell.vertices()) tol_ = std::max(tol_, distance_band(v));
+    for (const vec3& v : cell.vertices()) tol_ = std::max(tol_, distance_band(v, cell.floor()));
     padded_ = (count_ + kLanes - 1) / kLanes * kLanes;
     // Padding lanes: h0 = +inf and h2 = -inf (no part below any plane, and no effect on the extent),
     // zero area.
