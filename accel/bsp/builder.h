@@ -55,11 +55,11 @@ class BspBuilder {
       NodePrims root = gather_root(ids, box);
       set_gain_floor(box, ids.size());
       count_frontier_root(ledger, root.size());
+      const ConvexCell cell = ConvexCell::from_box(box, band_floor(box));
       if (ledger && config_.reuse_decisions)
-        build_top(std::move(root), ConvexCell::from_box(box, band_floor(box)), Depth{0, 0, 0, budget}, out);
+        build_top(std::move(root), cell, Depth{0, 0, 0, budget}, out);
       else
-        build_node(std::move(root), ConvexCell::from_box(box, band_floor(box)), Depth{0, 0, 0, budget}, 0,
-                   out);
+        build_node(std::move(root), cell, Depth{0, 0, 0, budget}, 0, out);
     };
     budget_exhausted_ = build_with_budget(ids.size(), config_.ref_budget, depth_limit_, attempt);
     ledger_ = nullptr;

@@ -36,7 +36,7 @@ inline float near_duplicate(const vec3& v, float floor) {
 inline float band_floor(const AABB& b) {
   const vec3 m = glm::max(glm::abs(b.lo), glm::abs(b.hi));
   const float mag = std::max({m.x, m.y, m.z});
-  return mag >= 1.0f || !(mag == mag) ? 1.0f : std::max(mag, std::numeric_limits<float>::min());
+  return mag < 1.0f ? std::max(mag, std::numeric_limits<float>::min()) : 1.0f;  // NaN: 1
 }
 
 /// Makes kept buffer v at least n long; it never shrinks, so once grown the call does nothing (its users
