@@ -90,13 +90,4 @@ bool triangle_overlaps_box(const Triangle& tri, const AABB& box) {
   return !clipped_triangle_bounds(tri, box).empty();
 }
 
-AABB inflate_for_insertion(const AABB& box) {
-  const vec3 ext = box.extent();
-  const float scale =
-      std::max({ext.x, ext.y, ext.z, std::fabs(box.lo.x), std::fabs(box.lo.y), std::fabs(box.lo.z),
-                std::fabs(box.hi.x), std::fabs(box.hi.y), std::fabs(box.hi.z)});
-  const vec3 margin(scale * 0x1p-18f);
-  return {box.lo - margin, box.hi + margin};
-}
-
 }  // namespace ab

@@ -30,8 +30,4 @@ AABB clipped_triangle_bounds(const Triangle& tri, const AABB& box);
 /// Degenerate triangles (segments, points) are handled by the same clipping.
 bool triangle_overlaps_box(const Triangle& tri, const AABB& box);
 
-/// Box grown on every side by a margin relative to its size and position, for conservative insertion:
-/// a triangle within rounding of a cell's boundary is placed in that cell too.
-AABB inflate_for_insertion(const AABB& box);
-
 }  // namespace ab

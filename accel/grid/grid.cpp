@@ -64,7 +64,7 @@ GridLayout make_grid_layout(const AABB& bounds, size_t n, const GridConfig& conf
 }
 
 float insertion_margin(const GridLayout& g) {
-  return 2.0f * insertion_margin(g.box);
+  return 2.0f * InsertionMargin(g.box).of(g.box);
 }
 
 namespace {
@@ -160,7 +160,7 @@ void row_x_extent(const SlabPolygon& p, float lo, float hi, float& lo_x, float& 
 // cell range, clip the triangle to the slab widened by the margin; for each row of the slab polygon's y
 // range, the x extent of the slab polygon's part in the widened row (its clipped vertices, without building
 // the polygon), widened again, gives the cells. The widened
-// slabs and rows contain every cell box grown by inflate_for_insertion (whose growth is at most half the
+// slabs and rows contain every cell box grown by InsertionMargin::inflate (whose growth is at most half the
 // margin), so every cell the exact test against such a box accepts is found.
 void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, float margin,
                        std::vector<uint64_t>& out) {
@@ -196,7 +196,9 @@ void voxelize_triangle(const GridLayout& g, const Triangle& t, uint32_t id, floa
 
 CellInserter box_test_inserter(const GridLayout& g, std::span<const AABB> prim_bounds, OverlapTest overlaps) {
   const float margin = insertion_margin(g);
-  return [&g, prim_bounds, overlaps = std::move(overlaps), margin](uint32_t id, std::vector<uint64_t>& out) {
+  const InsertionMargin cells(g.box);
+  return [&g, prim_bounds, overlaps = std::move(overlaps), margin, cells](uint32_t id,
+                                                                          std::vector<uint64_t>& out) {
     if (prim_bounds[id].empty()) return;
     const CellRange r(g, prim_bounds[id], margin);
     // A range one cell thick on two axes needs no test: the primitive is connected, so it meets every
@@ -205,7 +207,7 @@ CellInserter box_test_inserter(const GridLayout& g, std::span<const AABB> prim_b
     for (int z = r.lo[2]; z <= r.hi[2]; ++z)
       for (int y = r.lo[1]; y <= r.hi[1]; ++y)
         for (int x = r.lo[0]; x <= r.hi[0]; ++x)
-          if (overlaps(id, inflate_for_insertion(g.cell_box(x, y, z))))
+          if (overlaps(id, cells.inflate(g.cell_box(x, y, z))))
             out.push_back((uint64_t(g.index(x, y, z)) << 32) | id);
   };
 }

@@ -82,18 +82,18 @@ using CellInserter = std::function<void(uint32_t id, std::vector<uint64_t>& out)
 using OverlapTest = std::function<bool(uint32_t, const AABB&)>;
 
 /// Generic insertion (any primitive set): every cell of the primitive's margin-widened bounds whose
-/// inflated box (inflate_for_insertion) the primitive overlaps according to `overlaps`.
+/// inflated box (InsertionMargin::inflate of the grid box) the primitive overlaps according to `overlaps`.
 CellInserter box_test_inserter(const GridLayout& layout, std::span<const AABB> prim_bounds,
                                OverlapTest overlaps);
 
 /// Triangle insertion by voxelization: the triangle is clipped to each slab of cells along z, the slab
 /// polygon to each row along y, and the row polygon's x extent gives the cells. Every slab, row and extent
-/// is widened by insertion_margin(), which covers every cell's inflate_for_insertion, so no cell the
+/// is widened by insertion_margin(), which covers every cell's inflation, so no cell the
 /// generic test would accept is lost.
 CellInserter triangle_inserter(const GridLayout& layout, std::span<const Triangle> triangles);
 
-/// Margin covering the inflation of every cell box of the grid (inflate_for_insertion grows a box by 2^-18
-/// of the largest of its extent and coordinates; this is twice that for the whole grid box).
+/// Margin covering the inflation of every cell box of the grid (InsertionMargin of the grid box, which no
+/// cell's exceeds; this is twice the grid box's).
 float insertion_margin(const GridLayout& layout);
 
 /// Two-pass insertion of primitives [0, n) (collect the (cell, id) pairs per block of primitives on TBB,
@@ -210,7 +210,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     GridConfig config = config_;
     for (;;) {
       layout_ = make_grid_layout(prims_->bounds(), n, config);
-      reach_ = reach_of(layout_.box);
+      reach_ = 0x1p22f * insertion_margin(layout_);
       insert_all(n, max_refs);
       if (!cells_.over_budget) break;
       config.lambda *= 0.5;
@@ -245,19 +245,15 @@ class Grid final : public AcceleratorBase<Grid<P>> {
 
  private:
   /// True for a ray whose origin lies so far from the grid that the rounding of its walk and of the kernel
-  /// (a few ulps of the origin's coordinates) may exceed the insertion margin (2^-17 of the grid box's
-  /// largest extent or coordinate): an origin coordinate beyond 2^5 times that magnitude. Such a ray tests
-  /// every primitive, as brute does (found by an outside check: from 1e7 away, every plane of a unit grid
-  /// lies within one ulp of the origin's coordinates, and the walk took cells the kernel's hit was not in).
+  /// (a few ulps of the origin's coordinates) may exceed the insertion margin: an origin coordinate beyond
+  /// 2^22 times the margin (2-4 ulps of it fill the margin). Such a ray tests every primitive, as brute does
+  /// (found by an outside check: from 1e7 away, every plane of a unit grid lies within one ulp of the
+  /// origin's coordinates, and the walk took cells the kernel's hit was not in). Near the origin the margin
+  /// is 2^-17 of the grid box's largest extent or coordinate, so the reach is 2^5 times that; far from it
+  /// (InsertionMargin: 2^-20 of the coordinates) 4 times the coordinates.
   bool far_origin(const Ray& ray) const {
     const vec3 o = glm::abs(ray.org);
     return !(std::max({o.x, o.y, o.z}) <= reach_);
-  }
-  /// 2^5 times the grid box's largest extent or coordinate (far_origin), made with the layout.
-  static float reach_of(const AABB& box) {
-    const vec3 e = box.extent();
-    const vec3 a = glm::max(glm::abs(box.lo), glm::abs(box.hi));
-    return 0x1p5f * std::max({e.x, e.y, e.z, a.x, a.y, a.z});
   }
   /// Calls f(id) for each primitive of the walk's current cell not yet tested for this ray; stops early
   /// when f returns true (f may return void).
@@ -286,7 +282,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   std::shared_ptr<const P> prims_;
   GridConfig config_;
   GridLayout layout_;
-  float reach_ = 0.0f;  ///< far_origin's bound (reach_of the layout's box)
+  float reach_ = 0.0f;  ///< far_origin's bound (2^22 times the layout's insertion margin)
   GridCells cells_;
 };
 

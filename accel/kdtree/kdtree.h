@@ -96,7 +96,7 @@ class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
       }
     }
     drop_empty_leaves(out.nodes);
-    margin_ = ids.empty() ? 0.0f : insertion_margin(box_);
+    margin_ = ids.empty() ? 0.0f : InsertionMargin(box_).of(box_);
     root_box_ = {box_.lo - vec3(margin_), box_.hi + vec3(margin_)};
     nodes_ = std::move(out.nodes);
     leaves_.assign(*prims_, std::move(out.refs), config_.leaf_copies);

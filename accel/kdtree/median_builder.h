@@ -36,6 +36,7 @@ class KdMedianBuilder {
 
   /// Builds the tree over the primitives ids (finite bounds) inside box into out.
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
+    margins_ = InsertionMargin(box);
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = KdBuffer{};
@@ -79,7 +80,7 @@ class KdMedianBuilder {
     if (n <= config_.leaf_size || depth >= depth_limit_ || !median_plane(node, axis, split))
       return make_leaf(node.ids, out);
     // Conservative: a primitive touching the plane or within the margin of it goes to both children.
-    const float margin = insertion_margin(node.box);
+    const float margin = margins_.of(node.box);
     auto side = [&](const AABB& cb) {
       const bool below = cb.lo[axis] <= split + margin, above = cb.hi[axis] >= split - margin;
       return uint8_t(below ? (above ? 3 : 1) : 2);
@@ -124,6 +125,7 @@ class KdMedianBuilder {
   int depth_limit_;
   mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
   mutable bool budget_exhausted_ = false;
+  mutable InsertionMargin margins_;  ///< the tree's insertion margins (its root box's rule, set by build)
 };
 
 }  // namespace ab

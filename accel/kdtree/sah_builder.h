@@ -58,6 +58,7 @@ class KdSahBuilder {
 
   /// Builds the tree over the primitives `ids` (finite bounds) inside `box` into out.
   void build(const std::vector<uint32_t>& ids, const AABB& box, KdBuffer& out) const {
+    margins_ = InsertionMargin(box);
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = KdBuffer{};
@@ -154,7 +155,7 @@ class KdSahBuilder {
   void partition(KdBoxNode&& node, int a, float split, bool planar_left, KdBoxNode& left,
                  KdBoxNode& right) const {
     partition_box_node(
-        prims_, node, a, split, insertion_margin(node.box),
+        prims_, node, a, split, margins_.of(node.box),
         [&](const AABB& cb) { return kd_side(cb.lo[a], cb.hi[a], split, planar_left); }, left, right);
     std::vector<uint32_t>().swap(node.ids);
     std::vector<AABB>().swap(node.bounds);
@@ -165,7 +166,7 @@ class KdSahBuilder {
   void partition(KdEventNode&& node, int a, float split, bool planar_left, KdEventNode& left,
                  KdEventNode& right) const {
     const size_t n = node.ids.size();
-    const float margin = insertion_margin(node.box);
+    const float margin = margins_.of(node.box);
     child_boxes(node.box, a, split, left.box, right.box);
     // Side of each primitive (bit 0 left, bit 1 right), Wald and Havran's classification: ending at or
     // before the plane is left only, starting at or after it right only, planar in it on the chosen side.
@@ -254,6 +255,7 @@ class KdSahBuilder {
   int depth_limit_;
   mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
   mutable bool budget_exhausted_ = false;
+  mutable InsertionMargin margins_;  ///< the tree's insertion margins (its root box's rule, set by build)
 };
 
 }  // namespace ab

@@ -11,9 +11,9 @@
 // - the reference budget (build_with_budget, refine_rules.h) as a safety net: at most ref_budget
 //   references per primitive, the tree unchanged on any input whose tree stays under it.
 // Primitives are inserted by exact primitive/box overlap against the child boxes grown by the insertion
-// margin (inflate_for_insertion, clip.h), so a primitive touching a cell or within rounding of its boundary
-// is in every such cell. Large nodes build their eight subtrees in parallel, each into its own buffer,
-// spliced in child order (the same tree for any thread count).
+// margin (InsertionMargin, conservative_insertion.h), so a primitive touching a cell or within rounding of
+// its boundary is in every such cell. Large nodes build their eight subtrees in parallel, each into its own
+// buffer, spliced in child order (the same tree for any thread count).
 #pragma once
 
 #include <tbb/parallel_for.h>
@@ -24,6 +24,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "accel/common/conservative_insertion.h"
 #include "accel/common/refine_rules.h"
 #include "accel/core/clip.h"
 #include "accel/core/primitives.h"
@@ -64,6 +65,7 @@ class OctreeBuilder {
       out.nodes.push_back(OctNode::leaf(0, 0));
       return;
     }
+    margins_ = InsertionMargin(box);
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
       ledger_ = ledger;
       out = OctBuffer{};
@@ -139,7 +141,7 @@ class OctreeBuilder {
   void distribute(const std::vector<uint32_t>& ids, const AABB& box,
                   std::array<std::vector<uint32_t>, 8>& kids) const {
     std::array<AABB, 8> child, grown;
-    for (int k = 0; k < 8; ++k) child[k] = octant_box(box, k), grown[k] = inflate_for_insertion(child[k]);
+    for (int k = 0; k < 8; ++k) child[k] = octant_box(box, k), grown[k] = margins_.inflate(child[k]);
     if constexpr (std::is_same_v<P, TrianglePrims>) {
       const OctantFrame frame(box, child, grown);
       for (uint32_t i : ids) {
@@ -161,6 +163,7 @@ class OctreeBuilder {
   int depth_limit_;
   mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
   mutable bool budget_exhausted_ = false;
+  mutable InsertionMargin margins_;  ///< the tree's insertion margins (its root box's rule, set by build)
 };
 
 }  // namespace ab

@@ -48,7 +48,7 @@ struct OctantFrame {
   vec3 mid{0.0f};     ///< the mid-planes (octant_box's)
   float band = 0.0f;  ///< the largest growth of a child box (its insertion margin)
 
-  /// The frame of child boxes child[k] and their grown boxes grown[k] (inflate_for_insertion).
+  /// The frame of child boxes child[k] and their grown boxes grown[k] (InsertionMargin::inflate).
   OctantFrame(const AABB& box, const std::array<AABB, 8>& child, const std::array<AABB, 8>& grown) {
     for (int k = 0; k < 8; ++k) {
       outer.extend(grown[k]);

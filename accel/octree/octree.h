@@ -93,7 +93,7 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
     AABB box;
     std::vector<uint32_t> ids = partition_finite(*prims_, unbounded_, box);
     box_ = cube_around(box);
-    margin_ = box_.empty() ? 0.0f : insertion_margin(box_);
+    margin_ = box_.empty() ? 0.0f : InsertionMargin(box_).of(box_);
     const int depth_limit =
         config_.auto_depth
             ? std::min(Config::kMaxDepth, std::max(config_.max_depth, auto_octree_depth_limit(ids.size())))
