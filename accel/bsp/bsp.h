@@ -72,11 +72,13 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
   void do_build() override {
     std::vector<uint32_t> ids = partition_finite(*prims_, unbounded_, box_);
     const int depth_limit = config_.max_depth > 0 ? config_.max_depth : auto_depth_limit(ids.size());
-    margin_ = ids.empty() ? 0.0f : insertion_margin(box_);
+    origin_ = frame_origin(box_);
+    const AABB local{box_.lo - origin_, box_.hi - origin_};
+    margin_ = ids.empty() ? 0.0f : insertion_margin(local);
     BspBuffer out;
     if (!ids.empty()) {
-      BspBuilder<P> builder(*prims_, config_, depth_limit, margin_);
-      builder.build(std::move(ids), box_, out);
+      BspBuilder<P> builder(*prims_, config_, depth_limit, margin_, origin_);
+      builder.build(std::move(ids), local, out);
       this->stats_.extra["budget_exhausted"] = builder.budget_exhausted();
     }
     drop_empty_leaves(out.nodes);
@@ -107,7 +109,9 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
   [[gnu::always_inline]] bool traverse(const Ray& ray, RayCounters& c, Leaf&& leaf, BestT&& best_t) const {
     float t0 = ray.tmin, t1 = ray.tmax;
     if (nodes_.empty() || !slab_test(box_, RayBoxData(ray), t0, t1)) return false;
-    const PlaneRay r(ray, margin_);
+    Ray local = ray;
+    local.org -= origin_;  // the planes' frame (the kernel gets the ray as it is)
+    const PlaneRay r(local, margin_);
     const BspPlane* planes = planes_.data();
     return walk_plane_tree<kCount>(
         nodes_.data(), t0, t1, c,
@@ -120,7 +124,20 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
 
   std::shared_ptr<const P> prims_;
   Config config_;
+  /// The origin of the tree's frame (issue 11, geometry far from the origin). Far from the world's origin
+  /// every band of the build and the walk scales with the coordinates: an oblique plane's offset and a
+  /// clipped point carry their rounding (an ulp of 1e6 is 1/16), so the insertion margin (2^-18 of them,
+  /// 3.8 at 1e6), the cell clipper's bands and the walk's band (2^-20 of |d| + |n|.|o|) all grew beyond
+  /// small triangles there, and most cells held most of the mesh. In a frame at the root box's centre the
+  /// planes, cells and parts have the mesh's own magnitude; the triangles' translation rounds by at most
+  /// half an ulp of that magnitude (nothing at all far away: both sides of v - c are close), which the
+  /// margin (2^-18 of it) covers; the ray origin's translation rounds by half an ulp of |o - c|, which the
+  /// walk's band (2^-20 of |n|.|o - c|) covers. A tree not far_from_origin (conservative_insertion.h) keeps
+  /// the world's frame, so those trees are the same bit for bit.
+  static vec3 frame_origin(const AABB& root) { return far_from_origin(root) ? root.center() : vec3(0.0f); }
+
   float margin_ = 0.0f;  ///< insertion margin, also the positional band of every plane crossing (PlaneRay)
+  vec3 origin_{0.0f};    ///< the origin of the planes' frame (frame_origin), in world coordinates
   AABB box_;
   std::vector<BspNode> nodes_;
   std::vector<BspPlane> planes_;

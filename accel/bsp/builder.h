@@ -37,11 +37,12 @@ namespace ab {
 template <class P>
 class BspBuilder {
  public:
-  /// Builder over prims with the tree's configuration, its resolved depth limit and its insertion margin.
-  BspBuilder(const P& prims, const BspConfig& config, int depth_limit, float margin)
-      : prims_(prims), config_(config), depth_limit_(depth_limit), margin_(margin) {}
+  /// Builder over prims with the tree's configuration, its resolved depth limit, its insertion margin and
+  /// the origin of its frame (BspTree::frame_origin): planes, cells and parts are in that frame.
+  BspBuilder(const P& prims, const BspConfig& config, int depth_limit, float margin, const vec3& origin)
+      : prims_(prims), config_(config), depth_limit_(depth_limit), margin_(margin), origin_(origin) {}
 
-  /// Builds over ids (finite bounds) inside box into out.
+  /// Builds over ids (finite bounds) inside box (in the builder's frame) into out.
   void build(std::vector<uint32_t> ids, const AABB& box, BspBuffer& out) const {
     BspBuffer first;  // the abandoned first attempt's nodes and planes: the second attempt's memo
     auto attempt = [&](RefLedger* ledger, RefBudget budget) {
@@ -106,7 +107,7 @@ class BspBuilder {
     const AABB g = grown(box);
     return collect(ids.size(), [&](size_t k, uint32_t& id, vec3* buf) {
       id = ids[k];
-      return support_points(prims_, id, g, buf);
+      return support_points(prims_, id, g, buf, origin_);
     });
   }
 
@@ -204,7 +205,7 @@ class BspBuilder {
     if constexpr (std::is_same_v<P, TrianglePrims>) {
       return clip_part(np, k, cut, box, out);
     } else {
-      return support_points(prims_, np.ids[k], box, out);
+      return support_points(prims_, np.ids[k], box, out, origin_);
     }
   }
 
@@ -700,7 +701,8 @@ class BspBuilder {
     thread_local std::vector<uint8_t> valid;
     grow_buffer(planes, k);
     grow_buffer(valid, k);
-    for (size_t j = 0; j < k; ++j) valid[j] = supporting_plane(prims_, np.ids[j * np.size() / k], planes[j]);
+    for (size_t j = 0; j < k; ++j)
+      valid[j] = supporting_plane(prims_, np.ids[j * np.size() / k], planes[j], origin_);
     for (size_t j = 0; j < k; ++j) {
       if (!valid[j]) continue;
       const BspPlane& own = planes[j];
@@ -909,6 +911,7 @@ class BspBuilder {
   BspConfig config_;
   int depth_limit_;                      ///< resolved depth limit (> 0)
   float margin_;                         ///< insertion margin (from the root box)
+  vec3 origin_;                          ///< the origin of the tree's frame, in world coordinates
   mutable RefLedger* ledger_ = nullptr;  ///< the unbudgeted attempt's ledger (build_with_budget)
   /// The first attempt's tree, during the second (memoized_decision).
   mutable const BspBuffer* memo_ = nullptr;

@@ -71,10 +71,16 @@ inline std::span<const size_t> bsp_direction_set(int k) {
 /// Most support points a primitive can have in a cell (a triangle clipped by a box).
 inline constexpr int kMaxSupportPoints = 32;
 
+/// Triangle t in a frame whose origin is at `origin` (BspTree's local frame far from the origin).
+inline Triangle translated(const Triangle& t, const vec3& origin) {
+  return {t.v0 - origin, t.v1 - origin, t.v2 - origin};
+}
+
 /// The points whose convex hull holds the part of triangle i inside box: the triangle clipped to the box
-/// (Sutherland-Hodgman, clip.h). Zero points when it misses the box.
-inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec3* out) {
-  const Triangle& t = p.triangle(i);
+/// (Sutherland-Hodgman, clip.h). Zero points when it misses the box. Box and points are in the frame whose
+/// origin is at `origin` (0: the world's, the same bits).
+inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec3* out, const vec3& origin) {
+  const Triangle t = translated(p.triangle(i), origin);
   ClipPolygon poly;
   poly.v[0] = t.v0;
   poly.v[1] = t.v1;
@@ -90,17 +96,19 @@ inline int support_points(const TrianglePrims& p, size_t i, const AABB& box, vec
 /// triangle's swept box): the corners of that box clipped to box.
 template <class P>
 requires std::same_as<P, InstancePrims> || std::same_as<P, MotionTrianglePrims>
-inline int support_points(const P& p, size_t i, const AABB& box, vec3* out) {
-  const AABB b = AABB::intersection(p.bounds(i), box);
+inline int support_points(const P& p, size_t i, const AABB& box, vec3* out, const vec3& origin) {
+  const AABB world = p.bounds(i);
+  const AABB b = AABB::intersection({world.lo - origin, world.hi - origin}, box);
   if (b.empty()) return 0;
   for (int c = 0; c < 8; ++c)
     out[c] = vec3((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z);
   return 8;
 }
 
-/// The supporting plane of triangle i (false for a degenerate triangle).
-inline bool supporting_plane(const TrianglePrims& p, size_t i, BspPlane& plane) {
-  const Triangle& t = p.triangle(i);
+/// The supporting plane of triangle i (false for a degenerate triangle), in the frame whose origin is at
+/// `origin`.
+inline bool supporting_plane(const TrianglePrims& p, size_t i, BspPlane& plane, const vec3& origin) {
+  const Triangle t = translated(p.triangle(i), origin);
   const vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
   const float len = glm::length(n);
   if (!(len > 0.0f) || !std::isfinite(len)) return false;
@@ -111,7 +119,7 @@ inline bool supporting_plane(const TrianglePrims& p, size_t i, BspPlane& plane) 
 /// Instances and moving triangles offer no supporting plane (their boxes are classified by corners only).
 template <class P>
 requires std::same_as<P, InstancePrims> || std::same_as<P, MotionTrianglePrims>
-inline bool supporting_plane(const P&, size_t, BspPlane&) {
+inline bool supporting_plane(const P&, size_t, BspPlane&, const vec3&) {
   return false;
 }
 
