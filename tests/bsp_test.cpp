@@ -370,13 +370,14 @@ TEST(Bsp, StatisticsAndThreadIndependence) {
   EXPECT_EQ(one.nodes, 2 * one.leaves - 1);
   EXPECT_GE(one.references, 20000u);
   // Stored nodes (empty leaves are flags in their parents), a plane per interior node, the ids and, with
-  // at most 3 references per triangle (leaf_copies=auto), leaf-order triangle copies.
+  // at most 3 references per triangle (leaf_copies=auto), leaf-order prepared triangles, else one per
+  // triangle.
   const uint64_t stored = one.extra.at("stored_nodes").get<uint64_t>();
   EXPECT_EQ(stored, one.nodes - one.empty_leaves);
   const bool copies = one.extra.at("leaf_copies").get<bool>();
   EXPECT_EQ(copies, one.references <= 3 * one.primitives);
-  EXPECT_EQ(one.bytes, stored * 8 + (one.nodes - one.leaves) * 16 +
-                           one.references * (4 + (copies ? sizeof(Triangle) : 0)));
+  EXPECT_EQ(one.bytes, stored * 8 + (one.nodes - one.leaves) * 16 + one.references * 4 +
+                           (copies ? one.references : one.primitives) * sizeof(PreparedTriangle));
 }
 
 TEST(Bsp, RejectsBadParameters) {

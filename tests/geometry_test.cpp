@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <bit>
+
 #include "accel/core/box_test.h"
 #include "accel/core/triangle.h"
+#include "structure_test_helpers.h"
 
 namespace ab {
 namespace {
@@ -99,6 +102,35 @@ TEST(TriangleKernel, RaysLyingInAnObliquePlaneNeverHit) {
   const vec3 n = glm::cross(e1, e2);
   EXPECT_TRUE(intersect_triangle({tri.centroid() + n, -n, 0.0f, kInf}, tri, h));
   EXPECT_NEAR(h.t, 1.0f, 1e-5f);
+}
+
+TEST(TriangleKernel, PreparedTrianglesGiveTheKernelsBits) {
+  // Degenerate, sliver and ordinary triangles, rays through their vertices and edges and in their planes.
+  using testing::adversarial_rays;
+  const Mesh mesh = testing::adversarial_mesh(6), soup = testing::random_soup(400, 5, 0.5f);
+  std::vector<Ray> rays = adversarial_rays(mesh, 1500, 9);
+  const auto more = adversarial_rays(soup, 1500, 10);
+  rays.insert(rays.end(), more.begin(), more.end());
+  size_t hits = 0, tests = 0;
+  for (const Mesh* m : {&mesh, &soup})
+    for (size_t i = 0; i < m->size(); ++i) {
+      const Triangle tri = m->triangle(i);
+      const PreparedTriangle prepared = prepare_triangle(tri, uint32_t(i));
+      ASSERT_EQ(prepared.id, uint32_t(i));
+      for (size_t r = i % 5; r < rays.size(); r += 7, ++tests) {
+        const float l1_dir = l1_norm(to_lanes(rays[r].dir));
+        TriangleHit a{}, b{};
+        const bool scalar = intersect_triangle(rays[r], tri, a);
+        ASSERT_EQ(intersect_prepared(rays[r], l1_dir, prepared, b), scalar)
+            << "triangle " << i << " ray " << r;
+        if (!scalar) continue;
+        ++hits;
+        EXPECT_EQ(std::bit_cast<uint32_t>(a.t), std::bit_cast<uint32_t>(b.t));
+        EXPECT_EQ(std::bit_cast<uint32_t>(a.u), std::bit_cast<uint32_t>(b.u));
+        EXPECT_EQ(std::bit_cast<uint32_t>(a.v), std::bit_cast<uint32_t>(b.v));
+      }
+    }
+  EXPECT_GT(hits, 1000u) << tests;  // the comparison saw real hits
 }
 
 TEST(AcceptanceRule, CloserThenLowerInstanceThenLowerPrim) {

@@ -276,13 +276,16 @@ TEST(KdTree, StatisticsDescribeABinaryTree) {
     }
     EXPECT_EQ(refs, s.references);
     EXPECT_EQ(leaves, s.leaves);
-    // Stored nodes (empty leaves are flags in their parents), ids and leaf-order triangle copies.
+    // Stored nodes (empty leaves are flags in their parents), ids and the prepared triangles (leaf order
+    // when copied, else one per triangle).
     const uint64_t stored = s.extra.at("stored_nodes").get<uint64_t>();
     EXPECT_EQ(stored, s.nodes - s.empty_leaves) << name;
     // leaf_copies=auto: copies when there are at most 3 references per triangle.
     const bool copies = s.extra.at("leaf_copies").get<bool>();
     EXPECT_EQ(copies, s.references <= 3 * s.primitives) << name;
-    EXPECT_EQ(s.bytes, stored * 8 + s.references * (4 + (copies ? sizeof(Triangle) : 0))) << name;
+    EXPECT_EQ(s.bytes, stored * 8 + s.references * 4 +
+                           (copies ? s.references : s.primitives) * sizeof(PreparedTriangle))
+        << name;
     EXPECT_LE(s.max_depth, uint32_t(auto_depth_limit(3000)));
   }
   EXPECT_LE(built("kdtree-median", mesh, {{"max_depth", "5"}})->stats().max_depth, 5u);

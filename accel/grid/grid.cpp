@@ -20,6 +20,7 @@ GridConfig GridConfig::read(Params& params) {
   params.read("lambda", c.lambda, 0.01, 100.0);
   params.read("max_cells", c.max_cells, 1, double(1ll << 31));
   params.read("ref_budget", c.ref_budget, 1.0, 1e6);
+  params.read("leaf_copies", c.leaf_copies, kLeafCopiesWords);
   return c;
 }
 
@@ -364,7 +365,7 @@ void gather_grid_stats(const GridLayout& g, const GridCells& cells, const GridCo
   stats.nodes = n;
   stats.max_depth = 0;
   stats.mean_leaf_depth = 0.0;
-  stats.bytes = (cells.offsets.size() + cells.ids.size()) * sizeof(uint32_t);
+  stats.bytes = cells.offsets.size() * sizeof(uint32_t);  // the Grid adds its cells' references (LeafRefs)
   stats.extra["resolution"] = {g.res[0], g.res[1], g.res[2]};
   stats.extra["lambda"] = config.lambda;
   stats.extra["cells"] = n;

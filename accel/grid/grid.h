@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "accel/common/leaf_refs.h"
 #include "accel/common/mailbox.h"
 #include "accel/core/accelerator.h"
 #include "accel/core/box_test.h"
@@ -30,6 +31,7 @@ struct GridConfig {
   /// The cells hold at most this many references per primitive: a grid that would hold more is built
   /// again with lambda halved (an eighth of the cells) until it fits.
   double ref_budget = 32.0;
+  LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into cell order (LeafRefs)
 
   /// Reads every field from params.
   static GridConfig read(Params& params);
@@ -127,7 +129,7 @@ struct GridWalk {
 };
 
 /// Statistics of a built grid for the one statistics walk (tree_stats.h: the cells as the leaves of the
-/// grid box), with the bytes and the resolution.
+/// grid box), with the resolution and the bytes of the cells' offsets (the caller adds its references').
 void gather_grid_stats(const GridLayout& layout, const GridCells& cells, const GridConfig& config,
                        BuildStats& stats);
 
@@ -147,17 +149,18 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   AABB bounds() const override { return prims_->bounds(); }
   /// The grid's geometry (for tests).
   const GridLayout& layout() const { return layout_; }
-  /// The cells (for tests).
+  /// The cells' offsets (for tests; their ids moved to ids()).
   const GridCells& cells() const { return cells_; }
+  /// The cells' primitive ids, cell after cell (for tests).
+  const std::vector<uint32_t>& ids() const { return leaves_.ids(); }
 
   /// Closest hit: walks the cells in ray order and stops once the best hit lies before the current
   /// cell's exit (best.t < the exit distance widened towards the origin), so a primitive in a later cell,
-  /// which lies beyond that plane by more than the insertion margin, can neither beat nor tie it. The
-  /// primitives are tested on a copy of the ray whose tmax follows best.t, as in the trees' leaves
-  /// (intersect_id_list): the same hits, and a hit beyond the best skips the kernel's acceptance check.
+  /// which lies beyond that plane by more than the insertion margin, can neither beat nor tie it. A cell's
+  /// primitives are its references in LeafRefs, tested as the trees' leaves are (once per ray: the mailbox).
   template <bool kCount>
   void intersect_ray(const Ray& ray, Hit& best, uint32_t inst, RayCounters& c) const {
-    if (cells_.ids.empty()) return;
+    if (leaves_.ids().empty()) return;
     if (far_origin(ray)) {
       for (size_t i = 0; i < prims_->size(); ++i) prims_->template intersect<kCount>(i, ray, best, inst, c);
       return;
@@ -167,12 +170,9 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     if (!slab_test(layout_.box, rd, t0, t1)) return;
     GridWalk walk(layout_, ray, rd, t0);
     Mailbox mailbox;
-    Ray r = ray;
-    r.tmax = std::min(ray.tmax, best.t);
     for (;;) {
-      visit_cell<kCount>(walk, mailbox, c, [&](uint32_t id) {
-        if (prims_->template intersect<kCount>(id, r, best, inst, c)) r.tmax = std::min(ray.tmax, best.t);
-      });
+      const auto [first, count] = enter_cell<kCount>(walk, c);
+      leaves_.template intersect_unseen<kCount>(*prims_, first, count, ray, best, inst, c, mailbox);
       const float t_exit = widen_near(walk.exit());
       if (best.t < t_exit || t_exit > t1 || !walk.advance(layout_, rd)) return;
     }
@@ -181,7 +181,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   /// Any hit within [tmin, tmax]: the same walk, stopping at the first primitive that reports one.
   template <bool kCount>
   bool occluded_ray(const Ray& ray, RayCounters& c) const {
-    if (cells_.ids.empty()) return false;
+    if (leaves_.ids().empty()) return false;
     if (far_origin(ray)) {
       for (size_t i = 0; i < prims_->size(); ++i)
         if (prims_->template occluded<kCount>(i, ray, c)) return true;
@@ -193,10 +193,8 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     GridWalk walk(layout_, ray, rd, t0);
     Mailbox mailbox;
     for (;;) {
-      bool hit = false;
-      visit_cell<kCount>(walk, mailbox, c,
-                         [&](uint32_t id) { return hit = prims_->template occluded<kCount>(id, ray, c); });
-      if (hit) return true;
+      const auto [first, count] = enter_cell<kCount>(walk, c);
+      if (leaves_.template occluded_unseen<kCount>(*prims_, first, count, ray, c, mailbox)) return true;
       if (widen_near(walk.exit()) > t1 || !walk.advance(layout_, rd)) return false;
     }
   }
@@ -215,6 +213,8 @@ class Grid final : public AcceleratorBase<Grid<P>> {
       if (!cells_.over_budget) break;
       config.lambda *= 0.5;
     }
+    leaves_.assign(*prims_, std::move(cells_.ids), config_.leaf_copies);
+    cells_.ids.clear();
     this->stats_.extra["budget_exhausted"] = config.lambda != config_.lambda;
     this->stats_.extra["budget_lambda"] = config.lambda;
   }
@@ -241,6 +241,8 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   void gather_stats(BuildStats& stats) const override {
     stats.primitives = prims_->size();
     gather_grid_stats(layout_, cells_, config_, stats);
+    stats.bytes += leaves_.bytes();
+    stats.extra["leaf_copies"] = leaves_.copied();
   }
 
  private:
@@ -255,35 +257,25 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     const vec3 o = glm::abs(ray.org);
     return !(std::max({o.x, o.y, o.z}) <= reach_);
   }
-  /// Calls f(id) for each primitive of the walk's current cell not yet tested for this ray; stops early
-  /// when f returns true (f may return void).
-  template <bool kCount, class F>
-  void visit_cell(const GridWalk& walk, Mailbox& mailbox, RayCounters& c, F&& f) const {
+  /// The walk's current cell as a range of references (first, count), counted as a node and, when it
+  /// holds any, a leaf.
+  template <bool kCount>
+  std::pair<uint32_t, uint32_t> enter_cell(const GridWalk& walk, RayCounters& c) const {
     const size_t cell = layout_.index(walk.cell[0], walk.cell[1], walk.cell[2]);
     const uint32_t begin = cells_.offsets[cell], end = cells_.offsets[cell + 1];
     if constexpr (kCount) {
       ++c.nodes;
       if (end > begin) ++c.leaves;
     }
-    for (uint32_t k = begin; k < end; ++k) {
-      const uint32_t id = cells_.ids[k];
-      if (mailbox.seen(id)) {
-        if constexpr (kCount) ++c.mailbox_skips;
-        continue;
-      }
-      if constexpr (std::is_same_v<decltype(f(id)), bool>) {
-        if (f(id)) return;
-      } else {
-        f(id);
-      }
-    }
+    return {begin, end - begin};
   }
 
   std::shared_ptr<const P> prims_;
   GridConfig config_;
   GridLayout layout_;
   float reach_ = 0.0f;  ///< far_origin's bound (2^22 times the layout's insertion margin)
-  GridCells cells_;
+  GridCells cells_;     ///< the cells' offsets (their ids are in leaves_)
+  LeafRefs<P> leaves_;  ///< the cells' references, cell after cell, and the prepared triangles
 };
 
 }  // namespace ab
