@@ -23,9 +23,10 @@
 
 namespace ab {
 
-/// When the leaves copy their prepared triangles into leaf order (parameter leaf_copies: on, off, or auto =
-/// when the leaves hold at most kAutoCopyReferences references per triangle, so the copies cost at most
-/// 192 bytes per triangle).
+/// How the leaves store their triangles (parameter leaf_copies): on = prepared copies in leaf order; auto =
+/// the same when the leaves hold at most kAutoCopyReferences references per triangle (so the copies cost at
+/// most 192 bytes per triangle), else one prepared triangle per triangle in id order; off = neither, the
+/// kernel on the mesh's triangles by id (the least memory).
 enum class LeafCopies { kOff, kOn, kAuto };
 /// References per triangle up to which leaf_copies=auto copies.
 inline constexpr double kAutoCopyReferences = 3.0;
@@ -34,19 +35,18 @@ inline const std::map<std::string, LeafCopies> kLeafCopiesWords{
     {"auto", LeafCopies::kAuto}, {"on", LeafCopies::kOn}, {"off", LeafCopies::kOff}};
 
 /// The leaves' primitive references in leaf order: the original ids and, for triangle sets, the triangles
-/// prepared for the kernel (PreparedTriangle: terms and edge norms made once, the same bits), either copied
-/// into leaf order when asked (64 bytes per reference, so a leaf reads its triangles from one contiguous
-/// run, as the BVH's leaves do) or else once per triangle in id order (64 bytes per triangle, gathered by
-/// id). Other primitive sets (instances, moving triangles) are reached through their ids and their own
-/// kernel.
+/// prepared for the kernel (PreparedTriangle: terms and edge norms made once, the same bits), copied into
+/// leaf order (64 bytes per reference, so a leaf reads its triangles from one contiguous run, as the BVH's
+/// leaves do) or once per triangle in id order (64 bytes per triangle, gathered by id), as LeafCopies says.
+/// Other primitive sets (instances, moving triangles), and triangles with leaf_copies=off, are reached
+/// through their ids and their own kernel.
 template <class P>
 class LeafRefs {
  public:
   /// True when the primitive set can be prepared (triangles).
   static constexpr bool kCanCopy = std::is_same_v<P, TrianglePrims>;
 
-  /// Takes the leaf-ordered ids and prepares the triangles (in parallel): copies in leaf order as `mode`
-  /// says, otherwise one per triangle.
+  /// Takes the leaf-ordered ids and prepares the triangles as `mode` says (in parallel).
   void assign(const P& prims, std::vector<uint32_t> ids, LeafCopies mode) {
     ids_ = std::move(ids);
     tris_.clear();
@@ -54,7 +54,7 @@ class LeafRefs {
     if constexpr (kCanCopy) {
       const bool few = double(ids_.size()) <= kAutoCopyReferences * double(prims.size());
       copied_ = mode == LeafCopies::kOn || (mode == LeafCopies::kAuto && few);
-      tris_.resize(copied_ ? ids_.size() : prims.size());
+      tris_.resize(copied_ ? ids_.size() : mode == LeafCopies::kOff ? 0 : prims.size());
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tris_.size(), size_t(1) << 14), [&](const auto& r) {
         for (size_t k = r.begin(); k < r.end(); ++k) {
           const uint32_t id = copied_ ? ids_[k] : uint32_t(k);
@@ -77,14 +77,16 @@ class LeafRefs {
   [[gnu::always_inline]] void intersect(const P& prims, uint32_t first, uint32_t count, const Ray& ray,
                                         Hit& best, uint32_t inst, RayCounters& c) const {
     if constexpr (kCanCopy) {
-      if constexpr (kCount) c.prims += count;
-      const float l1_dir = l1_norm(to_lanes(ray.dir));
-      Ray r = ray;
-      r.tmax = std::min(ray.tmax, best.t);
-      for (uint32_t k = first, e = first + count; k < e; ++k) test(r, l1_dir, k, best, inst);
-    } else {
-      intersect_id_list<kCount>(prims, ids_.data() + first, count, ray, best, inst, c);
+      if (!tris_.empty()) {
+        if constexpr (kCount) c.prims += count;
+        const float l1_dir = l1_norm(to_lanes(ray.dir));
+        Ray r = ray;
+        r.tmax = std::min(ray.tmax, best.t);
+        for (uint32_t k = first, e = first + count; k < e; ++k) test(r, l1_dir, k, best, inst);
+        return;
+      }
     }
+    intersect_id_list<kCount>(prims, ids_.data() + first, count, ray, best, inst, c);
   }
   /// Closest hit over the references [first, first + count) that the mailbox has not seen for this ray:
   /// the same kernel, each primitive tested once however many of the ray's leaves reference it (a
@@ -102,11 +104,13 @@ class LeafRefs {
         continue;
       }
       if constexpr (kCanCopy) {
-        if constexpr (kCount) ++c.prims;
-        test(r, l1_dir, k, best, inst);
-      } else if (prims.template intersect<kCount>(ids_[k], r, best, inst, c)) {
-        r.tmax = std::min(ray.tmax, best.t);
+        if (!tris_.empty()) {
+          if constexpr (kCount) ++c.prims;
+          test(r, l1_dir, k, best, inst);
+          continue;
+        }
       }
+      if (prims.template intersect<kCount>(ids_[k], r, best, inst, c)) r.tmax = std::min(ray.tmax, best.t);
     }
   }
   /// True when any reference in [first, first + count) that the mailbox has not seen blocks the ray.
@@ -127,16 +131,17 @@ class LeafRefs {
   [[gnu::always_inline]] bool occluded(const P& prims, uint32_t first, uint32_t count, const Ray& ray,
                                        RayCounters& c) const {
     if constexpr (kCanCopy) {
-      const float l1_dir = l1_norm(to_lanes(ray.dir));
-      for (uint32_t k = first, e = first + count; k < e; ++k) {
-        if constexpr (kCount) ++c.prims;
-        TriangleHit th;
-        if (intersect_prepared(ray, l1_dir, prepared(k), th)) return true;
+      if (!tris_.empty()) {
+        const float l1_dir = l1_norm(to_lanes(ray.dir));
+        for (uint32_t k = first, e = first + count; k < e; ++k) {
+          if constexpr (kCount) ++c.prims;
+          TriangleHit th;
+          if (intersect_prepared(ray, l1_dir, prepared(k), th)) return true;
+        }
+        return false;
       }
-      return false;
-    } else {
-      return occluded_id_list<kCount>(prims, ids_.data() + first, count, ray, c);
     }
+    return occluded_id_list<kCount>(prims, ids_.data() + first, count, ray, c);
   }
 
  private:
