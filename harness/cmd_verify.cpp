@@ -2,7 +2,7 @@
 // N]` Traces with every named accelerator, with brute force and with Embree; prints the agreement table; exit
 // 1 on any hit that differs from brute's, or any disagreement with Embree that is not explained. The outside
 // references (cgal, bullet) are classified against brute force as Embree's hits are (agree, tie, edge,
-// graze, limit), an unexplained disagreement failing the same way.
+// graze, limit, rounding), an unexplained disagreement failing the same way.
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -59,10 +59,10 @@ std::vector<Hit> trace_with(const Target& target, const std::string& name, const
 
 /// One row of the table: the build time, the comparison with brute force and the classified agreement.
 void print_row(const std::string& name, double build, const std::string& vs_brute, const Agreement& ag) {
-  std::printf("%-16s %9.3f  %-22s %9llu %7llu %7llu %7llu %7llu %11llu\n", name.c_str(), build,
+  std::printf("%-16s %9.3f  %-22s %9llu %7llu %7llu %7llu %7llu %8llu %11llu\n", name.c_str(), build,
               vs_brute.c_str(), (unsigned long long)ag.agree, (unsigned long long)ag.tie,
               (unsigned long long)ag.edge, (unsigned long long)ag.graze, (unsigned long long)ag.limit,
-              (unsigned long long)ag.unexplained);
+              (unsigned long long)ag.rounding, (unsigned long long)ag.unexplained);
   if (!ag.unexplained) return;
   std::printf("  unexplained disagreements at rays:");
   for (uint64_t i : ag.unexplained_rays) std::printf(" %llu", (unsigned long long)i);
@@ -88,8 +88,8 @@ int run_verify(const VerifyArgs& a) {
   std::vector<Hit> brute;
   bool failed = false;
   std::printf("%s: %zu triangles, %zu rays\n", target.path.c_str(), size_t(target.triangles), rays.size());
-  std::printf("%-16s %9s  %-22s %9s %7s %7s %7s %7s %11s\n", "accelerator", "build s", "vs brute", "agree",
-              "tie", "edge", "graze", "limit", "unexplained");
+  std::printf("%-16s %9s  %-22s %9s %7s %7s %7s %7s %8s %11s\n", "accelerator", "build s", "vs brute",
+              "agree", "tie", "edge", "graze", "limit", "rounding", "unexplained");
   for (const std::string& name : accelerator_list(a.accels, target.scene != nullptr)) {
     double build = 0.0;
     const std::vector<Hit> hits = trace_with(target, name, rays, a.threads, build);

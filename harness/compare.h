@@ -31,12 +31,15 @@ struct Agreement {
   uint64_t edge = 0;
   /// A hit triangle is nearly parallel to the ray (|cos| < 1e-3, or the kernel calls it parallel).
   uint64_t graze = 0;
-  uint64_t limit = 0;                      ///< a hit t is within rounding of tmin or tmax
+  uint64_t limit = 0;  ///< a hit t is within rounding of tmin or tmax
+  /// The same triangle at t's apart by less than the two kernels' rounding bound on t (on a sliver, whose
+  /// normal is ill-conditioned, a few percent of t at ordinary angles).
+  uint64_t rounding = 0;
   uint64_t unexplained = 0;                ///< anything else: a real disagreement
   std::vector<uint64_t> unexplained_rays;  ///< up to 10 ray indices
 
-  /// Disagreements that are explained by arithmetic (tie, edge, graze, limit).
-  uint64_t explained() const { return tie + edge + graze + limit; }
+  /// Disagreements that are explained by arithmetic (tie, edge, graze, limit, rounding).
+  uint64_t explained() const { return tie + edge + graze + limit + rounding; }
 };
 
 /// World-space triangle of a hit (mesh: triangle prim; scene: the instance's transformed triangle).

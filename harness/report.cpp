@@ -78,7 +78,8 @@ const std::vector<std::string>& csv_columns() {
                                                 "rebuilt",
                                                 "update_sah_cost",
                                                 "sah_ratio_to_rebuild",
-                                                "frame_seconds"};
+                                                "frame_seconds",
+                                                "embree_rounding"};
   return columns;
 }
 

@@ -95,6 +95,7 @@ bool verify_agreement(const Target& target, const std::string& what, const RaySe
             {"embree_edge", a.edge},
             {"embree_graze", a.graze},
             {"embree_limit", a.limit},
+            {"embree_rounding", a.rounding},
             {"embree_unexplained", a.unexplained}});
   if (a.unexplained == 0) return true;
   fail(what + ": " + std::to_string(a.unexplained) + " unexplained disagreements with " +

@@ -31,7 +31,7 @@ struct RaySet {
 using FailureSink = std::function<void(const std::string& what)>;
 
 /// True for every structure of the project, held to brute force byte for byte; false for Embree, whose hits
-/// are classified (agree, tie, edge, graze, limit) instead.
+/// are classified (agree, tie, edge, graze, limit, rounding) instead.
 bool is_exact(const std::string& accelerator);
 
 /// Accelerator `name` over the target with its default parameters, built.
