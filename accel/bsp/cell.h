@@ -416,15 +416,9 @@ class CellSurface {
         cutting[count++] = uint32_t(k);
       }
     }
-    grow_buffer(lanes_, 2 * kLanes * count);
-    for (size_t q = 0; q < count; ++q) area_below<Chunk>(d[cutting[q]], &lanes_[2 * kLanes * q]);
-    for (size_t q = 0; q < count; ++q) {  // the planes' lane sums are independent: they overlap
-      const float* l = &lanes_[2 * kLanes * q];
-      float sb = 0.0f, sc = 0.0f;
-      for (size_t j = 0; j < kLanes; ++j) {
-        sb += l[j];
-        sc -= l[kLanes + j];
-      }
+    for (size_t q = 0; q < count; ++q) {
+      float sb, sc;
+      area_below<Chunk>(d[cutting[q]], sb, sc);
       const size_t k = cutting[q];
       const float x = std::max(sc, 0.0f);
       above[k] = std::max(total_ - sb, 0.0f) + x;
@@ -476,6 +470,18 @@ class CellSurface {
     for (size_t i = 0; i < count; ++i) weighted[i] = (x * nx[i] + y * ny[i] + z * nz[i]) * ar[i];
   }
 
+  using Lanes8 = float __attribute__((vector_size(8 * sizeof(float))));    ///< 8 floats as one value
+  using Lanes16 = float __attribute__((vector_size(16 * sizeof(float))));  ///< 16 floats as one value
+  /// The smallest of the 8 lanes of v (halves, quarters, pairs).
+  static float lowest_of(Lanes8 v) {
+    using M = int32_t __attribute__((vector_size(8 * sizeof(int32_t))));
+    for (const M& m : {M{4, 5, 6, 7, 0, 1, 2, 3}, M{2, 3, 0, 1, 6, 7, 4, 5}, M{1, 0, 3, 2, 5, 4, 7, 6}}) {
+      const Lanes8 w = __builtin_shuffle(v, m);
+      v = w < v ? w : v;
+    }
+    return v[0];
+  }
+
   /// The heights of every triangle along n, sorted, with the reciprocals of the two quadratics'
   /// denominators, the area and the area times dot(n, normal), field by field (heights_), and the
   /// extent; nothing when they are those of n already.
@@ -486,31 +492,35 @@ class CellSurface {
     const size_t padded = padded_;
     heights(count_, padded, n, in_, heights_.data());
     const float *h0 = heights_.data(), *h2 = h0 + 2 * padded;
-    std::array<float, kLanes> lo, hi;
-    lo.fill(kInf);
-    hi.fill(-kInf);
+    // Each block's lowest h0 and the extent, in vectors of 8 (a block's minimum as a scalar chain was
+    // most of prepare's instructions). Minima and maxima of finite heights in any order: the same values
+    // (a zero's sign aside, which no comparison or difference below tells apart).
+    static_assert(kLanes == 16, "a block is two vectors of 8");
+    Lanes8 lo = Lanes8{} + kInf, hi = Lanes8{} - kInf;
     grow_buffer(block_low_, padded / kLanes);
     for (size_t i = 0; i < padded; i += kLanes) {
-      float block = kInf;
-      for (size_t l = 0; l < kLanes; ++l) {
-        lo[l] = std::min(lo[l], h0[i + l]);
-        hi[l] = std::max(hi[l], h2[i + l]);
-        block = std::min(block, h0[i + l]);
-      }
-      block_low_[i / kLanes] = block;
+      Lanes8 a, b, c, e;
+      std::memcpy(&a, h0 + i, sizeof(Lanes8));
+      std::memcpy(&b, h0 + i + 8, sizeof(Lanes8));
+      std::memcpy(&c, h2 + i, sizeof(Lanes8));
+      std::memcpy(&e, h2 + i + 8, sizeof(Lanes8));
+      const Lanes8 low = b < a ? b : a;
+      lo = low < lo ? low : lo;
+      const Lanes8 high = e > c ? e : c;
+      hi = high > hi ? high : hi;
+      block_low_[i / kLanes] = lowest_of(low);
     }
-    lowest_ = *std::min_element(lo.begin(), lo.end());
-    highest_ = *std::max_element(hi.begin(), hi.end());
+    lowest_ = lowest_of(lo);
+    highest_ = -lowest_of(-hi);  // exact: negation only flips the sign
   }
 
-  using Lanes8 = float __attribute__((vector_size(8 * sizeof(float))));    ///< 8 floats as one value
-  using Lanes16 = float __attribute__((vector_size(16 * sizeof(float))));  ///< 16 floats as one value
-  /// The per-lane sums of the surface's area below d and of the cut face's share (kLanes each, into out),
-  /// over kLanes triangles at a time (one accumulator per lane), in vectors of Chunk lanes (GCC's vector
-  /// extension: the per-lane sums stay in registers from block to block; as arrays they went through
-  /// memory every block, behind a run-time aliasing check).
+  /// The surface's area below d (sb) and the cut face's share (sc): kLanes triangles at a time, one
+  /// accumulator per lane, in vectors of Chunk lanes (GCC's vector extension: the per-lane sums stay in
+  /// registers from block to block; as arrays they went through memory every block, behind a run-time
+  /// aliasing check), and the lanes added pairwise (halves, lane_sum; they were stored and added one after
+  /// another, a chain of 32 additions per plane, and most calls price only a few planes).
   template <size_t Chunk>
-  void area_below(float d, float* __restrict out) const {
+  void area_below(float d, float& sb, float& sc) const {
     using Lanes = std::conditional_t<Chunk == 8, Lanes8, Lanes16>;
     constexpr size_t kChunks = kLanes / Chunk;  // chunks per block of kLanes triangles
     static_assert((Chunk == 8 || Chunk == 16) && kChunks * Chunk == kLanes);
@@ -547,16 +557,33 @@ class CellSurface {
         c[q] += vw * f;
       }
     }
-    for (size_t q = 0; q < kChunks; ++q) {
-      std::memcpy(out + q * Chunk, &b[q], sizeof(Lanes));
-      std::memcpy(out + kLanes + q * Chunk, &c[q], sizeof(Lanes));
+    sb = lane_sum(halves(b));
+    sc = 0.0f - lane_sum(halves(c));
+  }
+  /// The sums of lanes l and l + 8 of a block's kLanes per-lane sums s (kChunks vectors of Chunk lanes).
+  template <class Lanes, size_t N>
+  static Lanes8 halves(const Lanes (&s)[N]) {
+    if constexpr (N == 2) {
+      return s[0] + s[1];
+    } else {
+      Lanes8 lo, hi;
+      std::memcpy(&lo, &s[0], sizeof(Lanes8));
+      std::memcpy(&hi, reinterpret_cast<const float*>(&s[0]) + 8, sizeof(Lanes8));
+      return lo + hi;
     }
+  }
+  /// The sum of v's lanes, pairwise: lanes l and l + 4, then l and l + 2, then the two (the same order in
+  /// every vector width, so the same bits).
+  static float lane_sum(Lanes8 v) {
+    using M = int32_t __attribute__((vector_size(8 * sizeof(int32_t))));
+    v += __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3});
+    v += __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5});
+    return v[0] + v[1];
   }
   static constexpr size_t kLanes = 16, kFields = 7;
 
   std::array<std::vector<float>, kInFields> in_;  ///< the triangles, field by field
   size_t count_ = 0, padded_ = 0;                 ///< triangles, and rounded up to kLanes
-  mutable std::vector<float> lanes_;              ///< areas()'s per-plane lane sums (area_below), kLanes each
   mutable std::vector<float> block_low_;          ///< each block of kLanes triangles' lowest h0 along dir_
   mutable std::vector<float> heights_;  ///< prepare's fields for dir_, field by field (padded_ each)
   mutable vec3 dir_{0.0f};
