@@ -813,8 +813,9 @@ class BspBuilder {
     nl.insert(nl.end(), l.begin(), l.begin() + ptrdiff_t(count));
     nr.insert(nr.end(), r.begin(), r.begin() + ptrdiff_t(count));
   }
-  /// Planes exact_candidates counts at once (a vector of 16 floats).
-  static constexpr size_t kCountLanes = 16;
+  /// Planes exact_candidates counts at once: a vector of the target's (CellSurface::kChunk; 16 on an AVX2
+  /// target padded a small node's few planes to two vectors).
+  static constexpr size_t kCountLanes = CellSurface::kChunk;
 
   /// The bin boundaries and the planes two margins outside the whole range, with binned counts.
   void binned_candidates(const float* lo, const float* hi, size_t n, float range_lo, float range_hi,
