@@ -785,8 +785,9 @@ class BspBuilder {
                         std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
     const size_t k = std::min(n, samples), first = d.size();
     for (size_t j = 0; j < k; ++j) {
-      d.push_back(lo[j * n / k]);  // primitive j above only (side_bits)
-      d.push_back(hi[j * n / k]);  // primitive j below only
+      const size_t i = k == n ? j : j * n / k;  // (no integer division per plane when every one is tried)
+      d.push_back(lo[i]);                       // primitive i above only (side_bits)
+      d.push_back(hi[i]);                       // primitive i below only
     }
     // The planes kCountLanes at a time (padded), primitive after primitive: the counts of a small node
     // in a vector or two, without a scalar remainder or a sum over the lanes.

@@ -525,11 +525,7 @@ class CellSurface {
     constexpr size_t kChunks = kLanes / Chunk;  // chunks per block of kLanes triangles
     static_assert((Chunk == 8 || Chunk == 16) && kChunks * Chunk == kLanes);
     Lanes b[kChunks] = {}, c[kChunks] = {};
-    Lanes at, one;
-    for (size_t l = 0; l < Chunk; ++l) {
-      at[l] = d;
-      one[l] = 1.0f;
-    }
+    const Lanes at = d - Lanes{}, one = 1.0f - Lanes{};  // broadcasts (x - 0 is x, -0 included)
     const size_t padded = padded_;
     const float *h0 = heights_.data(), *h1 = h0 + padded, *h2 = h1 + padded, *il = h2 + padded;
     const float *ih = il + padded, *area = ih + padded, *weighted = area + padded;
