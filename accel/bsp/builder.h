@@ -870,34 +870,38 @@ class BspBuilder {
   /// when samples >= n; that primitive on one side only), appended with exact counts.
   void exact_candidates(const float* lo, const float* hi, size_t n, size_t samples, std::vector<float>& d,
                         std::vector<uint32_t>& nl, std::vector<uint32_t>& nr) const {
-    const size_t k = std::min(n, samples), first = d.size();
-    for (size_t j = 0; j < k; ++j) {
-      const size_t i = k == n ? j : j * n / k;  // (no integer division per plane when every one is tried)
-      d.push_back(lo[i]);                       // primitive i above only (side_bits)
-      d.push_back(hi[i]);                       // primitive i below only
-    }
-    // The planes kCountLanes at a time (padded), primitive after primitive: the counts of a small node
-    // in a vector or two, without a scalar remainder or a sum over the lanes.
+    using F = float __attribute__((vector_size(kCountLanes * sizeof(float))));
+    using I = int32_t __attribute__((vector_size(kCountLanes * sizeof(int32_t))));
+    const size_t k = std::min(n, samples), count = 2 * k;
+    const size_t padded = (count + kCountLanes - 1) / kCountLanes * kCountLanes;
     thread_local std::vector<float> x;  // used only here: no call below builds a node
     thread_local std::vector<uint32_t> l, r;
-    const size_t count = d.size() - first, padded = (count + kCountLanes - 1) / kCountLanes * kCountLanes;
     grow_buffer(x, padded);  // kept buffers filled in place (assign was a call per node that rarely grew)
     grow_buffer(l, padded);
     grow_buffer(r, padded);
-    std::copy(d.begin() + ptrdiff_t(first), d.end(), x.begin());
-    std::fill(x.begin() + ptrdiff_t(count), x.begin() + ptrdiff_t(padded), 0.0f);
-    std::fill_n(l.begin(), padded, 0u);
-    std::fill_n(r.begin(), padded, 0u);
-    const float half = 0.5f * margin_;
-    for (size_t i = 0; i < n; ++i) {
-      const float a = lo[i], b = hi[i];
-      for (size_t j = 0; j < padded; ++j) {  // side_bits without branches (vectorized)
-        uint32_t below, above;
-        sides_of(a - x[j], b - x[j], half, below, above);
-        l[j] += below;
-        r[j] += above;
-      }
+    for (size_t j = 0; j < k; ++j) {
+      const size_t i = k == n ? j : j * n / k;  // (no integer division per plane when every one is tried)
+      x[2 * j] = lo[i];                         // primitive i above only (side_bits)
+      x[2 * j + 1] = hi[i];                     // primitive i below only
     }
+    std::fill(x.begin() + ptrdiff_t(count), x.begin() + ptrdiff_t(padded), 0.0f);
+    // The planes kCountLanes at a time, primitive after primitive: sides_of's operations per lane, the
+    // counts in registers (as arrays in memory, most of the time went to their loads and stores).
+    const F half = 0.5f * margin_ - F{}, zero = F{};
+    for (size_t c = 0; c < padded; c += kCountLanes) {
+      F at;
+      std::memcpy(&at, &x[c], sizeof(F));
+      I below = {}, above = {};
+      for (size_t i = 0; i < n; ++i) {
+        const F a = lo[i] - at, b = hi[i] - at;
+        const I below_band = b <= half, above_band = a >= -half, middle_above = a + b > zero;
+        below -= ~above_band | (below_band & ~middle_above);  // a true comparison is -1
+        above -= ~below_band | (above_band & middle_above);
+      }
+      std::memcpy(&l[c], &below, sizeof(I));
+      std::memcpy(&r[c], &above, sizeof(I));
+    }
+    d.insert(d.end(), x.begin(), x.begin() + ptrdiff_t(count));
     nl.insert(nl.end(), l.begin(), l.begin() + ptrdiff_t(count));
     nr.insert(nr.end(), r.begin(), r.begin() + ptrdiff_t(count));
   }
