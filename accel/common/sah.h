@@ -25,6 +25,9 @@ struct SahCosts {
   /// Tests needed for n primitives: ceil(n / block) (a shift for a power-of-two block: the cost is priced for
   /// every candidate plane, and an integer division is slow).
   float tests(size_t n) const {
+    // (A count below 2^63 converts from a signed integer to the same float in one instruction; an unsigned
+    // one takes a test and a branch, and the bsp prices a few hundred planes a node.)
+    if (block == 1) return float(int64_t(n));
     if (std::has_single_bit(block)) return float((n + block - 1) >> std::countr_zero(block));
     return float((n + block - 1) / block);
   }
