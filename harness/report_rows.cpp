@@ -24,7 +24,8 @@ json verification_method(const VerifySpec& v) {
        "brute_rays rays of every set (0: all), and with the reference structure (itself checked against "
        "brute force on those rays) on all rays; the timed passes' hits at every thread count must equal "
        "the counting pass's; any-hit answers must equal whether the reference found a hit; Embree's hits "
-       "are classified agree/tie/edge/graze/limit/rounding/unexplained, and an unexplained disagreement fails the "
+       "are classified agree/tie/edge/graze/limit/rounding/unexplained, and an unexplained disagreement "
+       "fails the "
        "run"}};
 }
 
