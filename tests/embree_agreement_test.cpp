@@ -41,6 +41,12 @@ TEST(EmbreeAgreement, BruteAgreesWithEmbreeOnEveryGeneratorAndRayKind) {
   }
 }
 
+/// The agreement of each pair (ours[i], theirs[i]) of hits of the one ray.
+Agreement classify_on(const Ray& ray, const std::vector<Hit>& ours, const std::vector<Hit>& theirs,
+                      const HitTriangleFn& triangle_of) {
+  return classify_agreement(std::vector<Ray>(ours.size(), ray), ours, theirs, triangle_of);
+}
+
 TEST(EmbreeAgreement, SliverHitsWithinRoundingOfALongEdgeAreEdgeCases) {
   // A sliver of aspect 3000 (length 0.3, height 1e-4): a hit 2e-8 from its long edge has a barycentric
   // weight of 2e-4, above the barycentric tolerance but well within float rounding at coordinates near 1.
@@ -54,9 +60,8 @@ TEST(EmbreeAgreement, SliverHitsWithinRoundingOfALongEdgeAreEdgeCases) {
   const Hit near_long_edge{0.5f, 0, 0, 0.3f, 2e-4f};  // weight of v2 (the apex above the long edge)
   const Hit inside_sliver{0.5f, 0, 0, 0.3f, 0.5f};
   const Hit inside_plain{0.5f, 1, 0, 0.3f, 0.3f};
-  const std::vector<Ray> rays(3, ray);
-  const std::vector<Hit> ours{miss, miss, miss}, theirs{near_long_edge, inside_sliver, inside_plain};
-  const Agreement a = classify_agreement(rays, ours, theirs, triangle_of);
+  const Agreement a =
+      classify_on(ray, {miss, miss, miss}, {near_long_edge, inside_sliver, inside_plain}, triangle_of);
   EXPECT_EQ(a.edge, 1u);
   EXPECT_EQ(a.unexplained, 2u);
   EXPECT_EQ(a.unexplained_rays, (std::vector<size_t>{1, 2}));
@@ -78,9 +83,7 @@ TEST(EmbreeAgreement, TheSameSliverAtTsWithinRoundingIsRoundingNotOtherwise) {
   const Hit embree{0.12534431f, 0, 0, 0.38646773f, 0.27669218f};
   const Hit far_on_needle{0.14f, 0, 0, 0.38644785f, 0.2768091f};  // 12% of t: beyond the bound
   const Hit plain_a{0.5f, 1, 0, 0.3f, 0.3f}, plain_b{0.5005f, 1, 0, 0.3f, 0.3f};  // 1e-3 on a plain one
-  const std::vector<Ray> rays(3, ray);
-  const std::vector<Hit> a_side{ours, ours, plain_a}, b_side{embree, far_on_needle, plain_b};
-  const Agreement a = classify_agreement(rays, a_side, b_side, triangle_of);
+  const Agreement a = classify_on(ray, {ours, ours, plain_a}, {embree, far_on_needle, plain_b}, triangle_of);
   EXPECT_EQ(a.rounding, 1u);
   EXPECT_EQ(a.unexplained, 2u);
   EXPECT_EQ(a.unexplained_rays, (std::vector<size_t>{1, 2}));
