@@ -684,8 +684,8 @@ class BspBuilder {
     // Parker 2008) below it.
     const auto& dirs = bsp_directions();
     const std::span<const size_t> set = bsp_direction_set(large ? 3 : config_.directions);
-    if (large ||
-        np.size() >= kParallelPrims) {  // (a huge node's ranges in parallel, one direction at a time)
+    // A large node's axes, and a huge node's directions (ranges in parallel), one direction at a time.
+    if (large || np.size() >= kParallelPrims) {
       for (size_t i : set) measured_planes(np, surface, cell_area, dirs[i], shave_ok, scratch, ch);
       if (!large) autopartition_planes(np, surface, cell_area, shave_ok, scratch, ch);
       return ch;
