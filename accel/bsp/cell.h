@@ -24,12 +24,12 @@ namespace ab {
 /// planes cutting such a cell were taken for no cut, cut faces' points merged (near_duplicate), and the
 /// cells lost triangles of the teapot at 1e-5 and of the bunny at 1e-2 to 1e-4 (docs/structures.md).
 inline float distance_band(const vec3& v, float floor) {
-  return 1e-6f * (floor + glm::length(v));
+  return 1e-6f * (floor + robust_length(v));
 }
 
 /// The distance within which two points of a cut face are one (a tenth of distance_band).
 inline float near_duplicate(const vec3& v, float floor) {
-  return 1e-7f * (floor + glm::length(v));
+  return 1e-7f * (floor + robust_length(v));
 }
 
 /// The bands' absolute floor for a tree whose root cell is box b: its largest coordinate magnitude, at
@@ -90,7 +90,7 @@ class ConvexCell {
   /// Surface area.
   float area() const {
     float a = 0.0f;
-    for (size_t k = 0; k < face_count(); ++k) a += glm::length(vector_area(face(k)));
+    for (size_t k = 0; k < face_count(); ++k) a += robust_length(vector_area(face(k)));
     return a;
   }
 
@@ -117,11 +117,11 @@ class ConvexCell {
       const vec3 ab = vb.done(), aa = va.done();
       sum_below += ab;
       sum_above += aa;
-      below += glm::length(ab);
-      above += glm::length(aa);
+      below += robust_length(ab);
+      above += robust_length(aa);
     }
-    below += glm::length(sum_below);
-    above += glm::length(sum_above);
+    below += robust_length(sum_below);
+    above += robust_length(sum_above);
   }
 
   /// Every face's vertices, face after face (for CellSurface).
@@ -273,10 +273,10 @@ class ConvexCell {
     const size_t first = out.size();
     for (const auto& [key, i] : keys)
       if (const vec3& v = pts[i];
-          out.size() == first || glm::length(v - out.back()) > near_duplicate(v, floor))
+          out.size() == first || robust_length(v - out.back()) > near_duplicate(v, floor))
         out.push_back(v);
     while (out.size() > first + 1 &&
-           glm::length(out[first] - out.back()) <= near_duplicate(out.back(), floor))
+           robust_length(out[first] - out.back()) <= near_duplicate(out.back(), floor))
       out.pop_back();
   }
 
@@ -433,7 +433,7 @@ class CellSurface {
   /// Appends triangle (a, b, c) unless it has no area.
   void add(const vec3& a, const vec3& b, const vec3& c) {
     const vec3 cr = glm::cross(b - a, c - a);
-    const float twice = glm::length(cr);
+    const float twice = robust_length(cr);
     if (!(twice > 0.0f)) return;
     const vec3 nrm = cr / twice;
     const float v[kInFields] = {a.x, a.y, a.z,          b.x,   b.y,   b.z,  c.x,
