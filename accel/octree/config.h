@@ -10,8 +10,10 @@ namespace ab {
 
 /// Configuration of the octree.
 struct OctreeConfig {
-  size_t leaf_size = 8;                        ///< a node with at most this many primitives is a leaf
-  int max_depth = 10;                          ///< deepest level of subdivision (with auto_depth: the least)
+  size_t leaf_size = 8;  ///< a node with at most this many primitives is a leaf
+  /// depth limit in levels that divide (a level whose largest child keeps more than 7/8 of a node of more
+  /// than 64 primitives does not count; kMaxDepth levels in all); with auto_depth: the least
+  int max_depth = 10;
   LeafCopies leaf_copies = LeafCopies::kAuto;  ///< copy triangles into leaf order (LeafRefs)
   bool auto_depth = true;  ///< depth limit max(max_depth, auto_octree_depth_limit(N)), at most kMaxDepth
   int bad_refines = 3;  ///< a node whose split is the bad_refines-th bad one on its path is a leaf (pbrt-v3)
