@@ -248,11 +248,10 @@ class BspBuilder {
   Decision decide(const NodePrims& np, const ConvexCell& cell, const Depth& depth) const {
     const size_t n = np.size();
     if (n <= 1 || depth.splits >= depth_limit_ || depth.levels >= depth_limit_ + kEmptyCutLevels) return {};
-    const float share = ray_share(n, cell);
-    const float local = share < 0.0f || !(depth.anchor_area > 0.0f) ? -1.0f : cell.area() / depth.anchor_area;
+    const RayShares share = ray_shares(n, cell, depth);
     auto ok = [&](float split) {
-      return pays(n, share, split, gain_floor_) ||
-             (local >= 0.0f && pays(n, local, split, depth.anchor_floor));
+      return pays(n, share.root, split, gain_floor_) ||
+             (share.local >= 0.0f && pays(n, share.local, split, depth.anchor_floor));
     };
     if (!ok((1.0f - config_.costs.empty_bonus) * config_.costs.traversal)) return {};
     const bool shave_ok =
@@ -288,12 +287,18 @@ class BspBuilder {
     root_area_ = ConvexCell::from_box(box, band_floor(box)).area();
     gain_floor_ = config_.min_gain / float(std::max<size_t>(n, 1));
   }
-  /// The node's share of the rays, area(cell) / area(root), when the minimum-gain rule applies to it (at
-  /// most max_leaf primitives, min_gain > 0, a root of some area); else -1.
-  float ray_share(size_t n, const ConvexCell& cell) const {
+  /// A node's shares of the rays: area(cell) / area(root), and area(cell) / area(anchor) against its
+  /// local anchor (kGainAnchorMin); -1 where the rule does not apply.
+  struct RayShares {
+    float root = -1.0f, local = -1.0f;
+  };
+  /// The node's shares when the minimum-gain rule applies to it (at most max_leaf primitives, min_gain > 0,
+  /// a root of some area; the local one with an anchor), from one computation of the cell's area.
+  RayShares ray_shares(size_t n, const ConvexCell& cell, const Depth& depth) const {
     if (!(gain_floor_ > 0.0f && root_area_ > 0.0f) || (config_.max_leaf > 0 && n > config_.max_leaf))
-      return -1.0f;
-    return cell.area() / root_area_;
+      return {};
+    const float area = cell.area();
+    return {area / root_area_, depth.anchor_area > 0.0f ? area / depth.anchor_area : -1.0f};
   }
   /// True when a split of a node of n primitives whose ray share is `share` at cost `split` (per unit of the
   /// node's area) saves the tree at least `floor` (always, when the rule does not apply: share < 0).

@@ -90,15 +90,12 @@ class OctreeBuilder {
     int zooms = 0;
   };
 
-  /// True when one child holds all the node's n primitives and the seven others none: the level cuts
-  /// empty space (stop).
-  static bool empty_cut(const std::array<std::vector<uint32_t>, 8>& kids, size_t n) {
-    size_t filled = 0, most = 0;
-    for (const auto& k : kids) {
-      filled += !k.empty();
-      most = std::max(most, k.size());
-    }
-    return filled == 1 && most == n;
+  /// True when one child holds all the node's primitives and the seven others none (every primitive lies
+  /// in some child, so the one non-empty child holds them all): the level cuts empty space (stop).
+  static bool empty_cut(const std::array<std::vector<uint32_t>, 8>& kids) {
+    size_t filled = 0;
+    for (const auto& k : kids) filled += !k.empty();
+    return filled == 1;
   }
   /// True when a level divides nothing: its largest child keeps more than 7/8 of the node's n primitives
   /// (an empty cut, or one beside a few large triangles: a ground plane's). The depth limit counts only
@@ -137,7 +134,7 @@ class OctreeBuilder {
     // a fan's centre (the poles of a tessellated sphere, all triangles sharing one vertex on the children's
     // common corner) every child holds all n, but a level further down only the cell at the vertex does,
     // and that cell shrinks eightfold per level. (bad_refines=0: no progress stops, as the rule is off.)
-    const bool stalled = !progress && !empty_cut(kids, n);
+    const bool stalled = !progress && !empty_cut(kids);
     if (refs == 0 || (stalled && config_.bad_refines == 0)) return true;  // refs 0: not distributed
     if (too_many_bad_refines(stalled || refs >= 4 * n, config_.bad_refines, path.bad)) return true;
     return !path.budget.allows(refs);
