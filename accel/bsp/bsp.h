@@ -93,6 +93,7 @@ class BspTree final : public SpatialTreeQueries<BspTree<P>> {
     stats.bytes = nodes_.size() * sizeof(BspNode) + planes_.size() * sizeof(BspPlane) + leaves_.bytes() +
                   unbounded_.size() * sizeof(uint32_t);
     stats.extra["unbounded_primitives"] = unbounded_.size();
+    stats.extra["never_hit_primitives"] = count_never_hit(*prims_);
     stats.extra["leaf_copies"] = leaves_.copied();
     size_t axis_planes = 0;
     for (const BspPlane& p : planes_) axis_planes += !is_oblique(p);

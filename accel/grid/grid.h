@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "accel/common/finite_primitives.h"
 #include "accel/common/leaf_refs.h"
 #include "accel/common/mailbox.h"
 #include "accel/core/accelerator.h"
@@ -223,7 +224,13 @@ class Grid final : public AcceleratorBase<Grid<P>> {
   void insert_all(size_t n, uint64_t max_refs) {
     if (layout_.cells() == 1) max_refs = UINT64_MAX;  // one cell: N references, within any budget
     if constexpr (std::is_same_v<P, TrianglePrims>) {
-      cells_ = build_grid_cells(layout_, n, triangle_inserter(layout_, prims_->triangles()), max_refs);
+      // Triangles the kernel can never hit (never_hit) get no cell.
+      const CellInserter voxelize = triangle_inserter(layout_, prims_->triangles());
+      const P& prims = *prims_;
+      const CellInserter hittable = [&prims, &voxelize](uint32_t id, std::vector<uint64_t>& out) {
+        if (!never_hit(prims, id)) voxelize(id, out);
+      };
+      cells_ = build_grid_cells(layout_, n, hittable, max_refs);
     } else {
       std::vector<AABB> boxes(n);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
@@ -243,6 +250,7 @@ class Grid final : public AcceleratorBase<Grid<P>> {
     gather_grid_stats(layout_, cells_, config_, stats);
     stats.bytes += leaves_.bytes();
     stats.extra["leaf_copies"] = leaves_.copied();
+    stats.extra["never_hit_primitives"] = count_never_hit(*prims_);
   }
 
  private:

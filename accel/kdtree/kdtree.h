@@ -107,6 +107,7 @@ class KdTree final : public SpatialTreeQueries<KdTree<P, M>> {
     stats.primitives = prims_->size();
     stats.bytes = nodes_.size() * sizeof(KdNode) + leaves_.bytes() + unbounded_.size() * sizeof(uint32_t);
     stats.extra["unbounded_primitives"] = unbounded_.size();
+    stats.extra["never_hit_primitives"] = count_never_hit(*prims_);
     stats.extra["leaf_copies"] = leaves_.copied();
     if (nodes_.empty()) return;
     walk_tree_stats(KdStatsVisitor{nodes_, box_}, stats);

@@ -112,6 +112,7 @@ class Octree final : public SpatialTreeQueries<Octree<P>> {
     stats.bytes = nodes_.size() * sizeof(OctNode) + leaves_.bytes() + unbounded_.size() * sizeof(uint32_t);
     stats.extra["leaf_copies"] = leaves_.copied();
     stats.extra["unbounded_primitives"] = unbounded_.size();
+    stats.extra["never_hit_primitives"] = count_never_hit(*prims_);
     walk_tree_stats(OctreeStatsVisitor{nodes_, box_}, stats);
   }
 
