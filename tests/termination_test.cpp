@@ -238,6 +238,18 @@ TEST(Termination, BspCostsTheSameAtAnyScale) {
   }
 }
 
+TEST(Termination, KdSahCostsTheSameAtTinyScales) {
+  // kdtree-sah prices its planes with ratios of box areas; below about 1e-19 the squares of the edges
+  // underflowed, every area was 0 and the tree nearly one leaf (here 107 triangle tests per ray against
+  // 1.95 at unit scale). The areas are now made in each node's area_frame (a power of two, exact).
+  const Mesh unit = random_soup(5000, 7, 0.02f);
+  const double at_unit = tests_per_primary_ray("kdtree-sah", unit);
+  Mesh scaled = unit;
+  for (vec3& v : scaled.vertices) v *= 1e-19f;
+  EXPECT_LT(tests_per_primary_ray("kdtree-sah", scaled), 1.5 * at_unit);
+  EXPECT_EQ(count_differences("kdtree-sah", scaled, adversarial_rays(scaled, 1500, 17)), 0u);
+}
+
 /// mesh with a ground square `scale` times its extent under it (two triangles at its lowest z).
 Mesh on_ground(Mesh mesh, float scale) {
   const AABB b = mesh.bounds();

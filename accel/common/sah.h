@@ -4,13 +4,31 @@
 // walk (tree_stats.h) through SahTreeCost. (The centroid binning of the binned BVH builder is binning.h.)
 #pragma once
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 #include "accel/core/aabb.h"
 
 namespace ab {
+
+/// The power of two by which a node's edge lengths e are multiplied before its areas are made: the SAH
+/// prices ratios of areas, which a power of two leaves exact. 1 when the longest edge lies in [2^-40, 2^40],
+/// so ordinary nodes keep their own bits; beyond, the one that brings it into [1, 2), since there the squares
+/// of the edges underflow (below about 1e-19) or overflow (above about 1e19) and every area is 0 or inf.
+inline float area_frame(const vec3& e) {
+  const float m = std::max({e.x, e.y, e.z});
+  if (!(m > 0.0f) || !std::isfinite(m) || (m >= 0x1p-40f && m <= 0x1p40f)) return 1.0f;
+  return std::ldexp(1.0f, std::clamp(-std::ilogb(m), -126, 127));
+}
+
+/// Surface area of box in its area_frame (the same ratios as its own areas, at any scale).
+inline float frame_area(const AABB& box) {
+  const vec3 e = box.extent();
+  return area_of_extent(e * area_frame(e));
+}
 
 /// The one SAH cost model of every builder: traversal and intersection costs, the empty-space bonus and
 /// the SIMD block size. The normalized cost reported in BuildStats uses 1 and 1 (kUnitSahCosts).

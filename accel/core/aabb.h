@@ -7,6 +7,11 @@
 
 namespace ab {
 
+/// Surface area of a box with edge lengths e.
+inline float area_of_extent(const vec3& e) {
+  return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
 /// Axis-aligned box; the default is empty (lo = +inf, hi = -inf).
 struct AABB {
   vec3 lo{kInf};
@@ -29,10 +34,7 @@ struct AABB {
   /// Midpoint.
   vec3 center() const { return 0.5f * (lo + hi); }
   /// Surface area (0 for an empty box).
-  float area() const {
-    const vec3 e = extent();
-    return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
-  }
+  float area() const { return area_of_extent(extent()); }
   /// Index of the longest axis.
   int longest_axis() const {
     const vec3 e = extent();

@@ -84,7 +84,7 @@ inline KdBins bin_kd_node(const KdBoxNode& node) {
 /// at the references' extent, which cut off empty space (counts exact: all on one side).
 inline KdSahChoice find_binned_kd_plane(const SahCosts& costs, const KdBoxNode& node) {
   KdSahChoice best;
-  if (!(node.box.area() > 0.0f)) return best;
+  if (!(frame_area(node.box) > 0.0f)) return best;
   const uint32_t n = uint32_t(node.ids.size());
   const KdBins bins = bin_kd_node(node);
   for (int a = 0; a < 3; ++a) {

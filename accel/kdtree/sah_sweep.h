@@ -64,18 +64,23 @@ struct KdSahPlane {
   uint32_t n_left = 0, n_right = 0;  ///< primitives on each side
 };
 
-/// Area terms of the children of a node box along one axis, so that each plane costs a few flops.
+/// Area terms of the children of a node box along one axis, so that each plane costs a few flops. They
+/// are made in the node's area_frame (sah.h), so the ratios are the same at any scale.
 struct KdAxisAreas {
-  float lo, hi, cap, side, inv_area;  ///< child area = (cap + side * length) * inv_area
+  float lo, hi, frame, cap, side, inv_area;  ///< child area = (cap + side * length * frame) * inv_area
 
   /// Terms of box along axis a.
   KdAxisAreas(const AABB& box, int a) : lo(box.lo[a]), hi(box.hi[a]) {
-    const vec3 e = box.extent();
+    const vec3 own = box.extent();
+    frame = area_frame(own);
+    const vec3 e = own * frame;
     const float e1 = e[(a + 1) % 3], e2 = e[(a + 2) % 3];
     cap = 2.0f * e1 * e2;
     side = 2.0f * (e1 + e2);
-    inv_area = 1.0f / box.area();
+    inv_area = 1.0f / area_of_extent(e);
   }
+  /// The share of the node's area of the child whose extent along the axis is `length`.
+  float share(float length) const { return (cap + side * (length * frame)) * inv_area; }
 };
 
 /// The cheapest plane of a node, and the cheapest one that leaves fewer than all n primitives on each side
@@ -98,8 +103,8 @@ inline void keep_cheaper(KdSahPlane& best, int a, float pos, float c, bool plana
 inline void evaluate_kd_plane(const SahCosts& costs, const KdAxisAreas& ar, int a, float pos, uint32_t nl,
                               uint32_t np, uint32_t nr, uint32_t n, KdSahChoice& choice,
                               bool planar_left = true) {
-  const float pl = (ar.cap + ar.side * (pos - ar.lo)) * ar.inv_area;
-  const float pr = (ar.cap + ar.side * (ar.hi - pos)) * ar.inv_area;
+  const float pl = ar.share(pos - ar.lo);
+  const float pr = ar.share(ar.hi - pos);
   const float cl = costs.split(1.0f, pl, nl + np, pr, nr);
   const float cr = np ? costs.split(1.0f, pl, nl, pr, nr + np) : cl;
   const bool left = np ? cl <= cr : planar_left;
@@ -112,7 +117,7 @@ inline void evaluate_kd_plane(const SahCosts& costs, const KdAxisAreas& ar, int 
 /// algorithm 4).
 inline KdSahChoice find_kd_sah_plane(const SahCosts& costs, const KdEventNode& node) {
   KdSahChoice best;
-  if (!(node.box.area() > 0.0f)) return best;
+  if (!(frame_area(node.box) > 0.0f)) return best;
   const uint32_t n = uint32_t(node.ids.size());
   for (int a = 0; a < 3; ++a) {
     const std::vector<KdEvent>& ev = node.events[a];
