@@ -184,7 +184,8 @@ TEST(Bvh8, FourLaneKernelGivesTheScalarKernelsBits) {
     const size_t n = std::min<size_t>(4, tris.size() - first);
     const Triangle4 quad = Triangle4::pack(std::span<const Triangle>(tris.data() + first, n));
     for (size_t r = first % 7; r < rays.size(); r += 5) {
-      const Ray4 ray4(rays[r]);
+      const RayBoxData box(rays[r]);
+      const Ray4 ray4(rays[r], box);
       alignas(16) float t[4], u[4], v[4];
       const unsigned mask = intersect_triangle4(ray4, quad, t, u, v);
       for (size_t j = 0; j < 4; ++j) {

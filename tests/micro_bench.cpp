@@ -129,8 +129,9 @@ void BM_RayTriangle4(benchmark::State& state) {
     for (Triangle& t : tris) t = random_triangle(rng);
     q = Triangle4::pack(tris);
   }
+  std::vector<RayBoxData> boxes(rays.begin(), rays.end());
   std::vector<Ray4> ray4;
-  for (const Ray& r : rays) ray4.emplace_back(r);
+  for (size_t r = 0; r < rays.size(); ++r) ray4.emplace_back(rays[r], boxes[r]);
   alignas(16) float t[4], u[4], v[4];
   size_t i = 0;
   for (auto _ : state) {

@@ -79,11 +79,12 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     const auto limit = [&] { return std::min(ray.tmax, best.t); };
     if (config_.width == 8) {
       if (wide_.empty()) return;
-      LeafRay leaf_ray(ray);
+      const Bvh8RayTest test(ray);
+      LeafRay leaf_ray = leaf_ray_of(ray, test.rd);
       const auto leaf = [&](uint32_t first, uint32_t count) {
         return wide_leaf<kCount, false>(first, count, ray, leaf_ray, &best, inst, c);
       };
-      walk_bvh8<kCount, true>(wide_.data(), ray, limit, leaf, leaf_data(), sizeof(Triangle4), c);
+      walk_bvh8<kCount, true>(wide_.data(), test, ray, limit, leaf, leaf_data(), sizeof(Triangle4), c);
       return;
     }
     if (nodes_.empty()) return;
@@ -103,11 +104,13 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
     const auto limit = [&] { return ray.tmax; };
     if (config_.width == 8) {
       if (wide_.empty()) return false;
-      LeafRay leaf_ray(ray);
+      const Bvh8RayTest test(ray);
+      LeafRay leaf_ray = leaf_ray_of(ray, test.rd);
       const auto leaf = [&](uint32_t first, uint32_t count) {
         return wide_leaf<kCount, true>(first, count, ray, leaf_ray, nullptr, 0, c);
       };
-      return walk_bvh8<kCount, false>(wide_.data(), ray, limit, leaf, leaf_data(), sizeof(Triangle4), c);
+      return walk_bvh8<kCount, false>(wide_.data(), test, ray, limit, leaf, leaf_data(), sizeof(Triangle4),
+                                      c);
     }
     if (nodes_.empty()) return false;
     return walk_bvh2<kCount, false>(
@@ -187,6 +190,14 @@ class Bvh final : public AcceleratorBase<Bvh<P, C>> {
 
   /// What a wide leaf is tested with: the ray broadcast to four lanes for triangle blocks, else the ray.
   using LeafRay = std::conditional_t<kCopiesTriangles, Ray4, Ray>;
+  /// The leaf ray of ray, sharing rd = RayBoxData(ray) (the walk's box test's) for the blocks' acceptance.
+  static LeafRay leaf_ray_of(const Ray& ray, const RayBoxData& rd) {
+    if constexpr (kCopiesTriangles) {
+      return Ray4(ray, rd);
+    } else {
+      return ray;
+    }
+  }
 
   /// Calls build(bounds, centroids) with the bounds and centroids of every primitive, gathered in parallel
   /// into uninitialized arrays (the binned and spatial-split builders read no centroids, so they get none).

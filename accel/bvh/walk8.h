@@ -266,10 +266,12 @@ template <bool kSorted, class Node>
 /// (kSorted) or in lane order; a stacked child is skipped only when its entry lies strictly beyond limit().
 /// Nodes and leaf data (`leaf_data` + first * `leaf_stride` bytes, when not null) are prefetched as soon as
 /// they are known to be entered. Returns true when a leaf ended the walk.
+/// `test` is the ray's box test (Node::RayTest made from ray), made by the caller so that it may share its
+/// RayBoxData with the leaves' test (Ray4): the reciprocals are then divided once per ray.
 template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
-[[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
-                                             const char* leaf_data, size_t leaf_stride, RayCounters& c) {
-  const typename Node::RayTest test(ray);
+[[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const typename Node::RayTest& test,
+                                             const Ray& ray, Limit limit, Leaf leaf, const char* leaf_data,
+                                             size_t leaf_stride, RayCounters& c) {
   Bvh8Stack stack;
   Bvh8StackEntry cur{0, 0, ray.tmin};
   for (;;) {
@@ -293,6 +295,14 @@ template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
     }
     if (!stack.pop(limit(), cur)) return false;
   }
+}
+
+/// walk_bvh8 with the box test made here.
+template <bool kCount, bool kSorted, class Limit, class Leaf, class Node>
+[[gnu::always_inline]] inline bool walk_bvh8(const Node* nodes, const Ray& ray, Limit limit, Leaf leaf,
+                                             const char* leaf_data, size_t leaf_stride, RayCounters& c) {
+  const typename Node::RayTest test(ray);
+  return walk_bvh8<kCount, kSorted>(nodes, test, ray, limit, leaf, leaf_data, leaf_stride, c);
 }
 
 }  // namespace ab

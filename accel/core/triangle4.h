@@ -100,25 +100,27 @@ struct alignas(64) Triangle4 {
 static_assert(sizeof(Triangle4) == 192);
 
 /// A ray broadcast to four lanes, with the L1 norm of its direction (made once per ray, as the kernel makes
-/// it), and the ray itself and its box data for the acceptance of a hit (kernel_hit_in_box; the ray must
-/// outlive this). A closest-hit walk lowers tmax to the best hit's t (set_tmax): the kernel's t, u and v do
-/// not depend on tmax, and a hit beyond the best one, which the acceptance rule refuses anyway, then skips
-/// the acceptance's box check.
+/// it), and the ray itself and its box data for the acceptance of a hit (kernel_hit_in_box; the ray and the
+/// box data, RayBoxData(ray), must outlive this: the 8-wide walk passes its box test's, so the reciprocals
+/// are divided once per ray). A closest-hit walk lowers tmax to the best hit's t (set_tmax): the kernel's t,
+/// u and v do not depend on tmax, and a hit beyond the best one, which the acceptance rule refuses anyway,
+/// then skips the acceptance's box check.
 struct Ray4 {
-  explicit Ray4(const Ray& r)
+  /// Ray r in four lanes; box_data is RayBoxData(r), kept by pointer.
+  Ray4(const Ray& r, const RayBoxData& box_data)
       : org{Lanes4(r.org.x), Lanes4(r.org.y), Lanes4(r.org.z)},
         dir{Lanes4(r.dir.x), Lanes4(r.dir.y), Lanes4(r.dir.z)},
         l1_dir(l1_norm(to_lanes(r.dir))),
         tmin(r.tmin),
         tmax(r.tmax),
         ray(&r),
-        box(r) {}
+        box(&box_data) {}
   /// Lanes' tmax: min(the ray's tmax, t), t the best hit so far.
   void set_tmax(float t) { tmax = Lanes4(std::min(ray->tmax, t)); }
   Vec3T<Lanes4> org, dir;
   Lanes4 l1_dir, tmin, tmax;
   const Ray* ray;
-  RayBoxData box;
+  const RayBoxData* box;
 };
 
 /// The kernel on four triangles: returns the mask of lanes hit (bit k for lane k) and their t, u, v.
@@ -134,7 +136,7 @@ struct Ray4 {
     _mm_storeu_ps(v, lv.v);
     for (unsigned rest = mask; rest; rest &= rest - 1) {  // the acceptance, lane by lane (hits are rare)
       const int k = std::countr_zero(rest);
-      if (!kernel_hit_in_box(*ray.ray, ray.box, tris.lane_terms(k), t[k])) mask &= ~(1u << k);
+      if (!kernel_hit_in_box(*ray.ray, *ray.box, tris.lane_terms(k), t[k])) mask &= ~(1u << k);
     }
   }
   return mask;
