@@ -93,6 +93,50 @@ Mesh nasty_mix() {
   return m;
 }
 
+/// Pages around a spine: triangles sharing one edge (the z axis), fanned around it at every angle, so every
+/// plane through the spine cuts them all and every ray near it crosses many.
+Mesh pages_around_edge() {
+  Mesh m;
+  Rng rng(3);
+  for (int i = 0; i < 60; ++i) {
+    const float a = 6.2831853f * float(i) / 60.0f;
+    add_triangle(m, {0, 0, 0}, {0, 0, 1}, {std::cos(a), std::sin(a), rng.uniform()});
+  }
+  return m;
+}
+
+/// Copies of one triangle stacked one float ulp apart (z = 1, its successor, ...), with triangles crossing
+/// the stack: neighbours no margin or plane can tell apart.
+Mesh ulp_stack() {
+  Mesh m;
+  Rng rng(5);
+  float z = 1.0f;
+  for (int i = 0; i < 40; ++i) {
+    add_triangle(m, {-1, -1, z}, {1, -1, z}, {0, 1, z});
+    z = std::nextafter(z, 2.0f);
+    if (i % 4 != 0) continue;
+    const float x0 = rng.uniform(-1, 1), x1 = rng.uniform(-1, 1), x2 = rng.uniform(-1, 1);
+    add_triangle(m, {x0, -1, 0.5f}, {x1, 1, 1.5f}, {x2, 0, 1});
+  }
+  return m;
+}
+
+/// A cluster of triangles of 1e-3 in 2e-2 on a ground of 2e4 (a millionth of the scene): detail below the
+/// spatial trees' root-relative insertion margin.
+Mesh cluster_on_ground() {
+  Mesh m;
+  add_triangle(m, {-1e4f, -1e4f, 0}, {1e4f, -1e4f, 0}, {1e4f, 1e4f, 0});
+  add_triangle(m, {-1e4f, -1e4f, 0}, {1e4f, 1e4f, 0}, {-1e4f, 1e4f, 0});
+  Rng rng(9);
+  for (int i = 0; i < 80; ++i) {
+    const vec3 c = vec3(2e-2f, 2e-2f, 2e-2f) * rng.unit_cube() - vec3(1e-2f, 1e-2f, 0);
+    auto corner = [&] { return c + 2e-3f * rng.unit_cube() - vec3(1e-3f); };
+    const vec3 a = corner(), b = corner();
+    add_triangle(m, a, b, corner());
+  }
+  return m;
+}
+
 Mesh one_triangle() {
   Mesh m;
   add_triangle(m, {0, 0, 0}, {1, 0, 0}, {0, 1, 0});
@@ -194,11 +238,15 @@ void check_mesh(const std::string& name, std::shared_ptr<const Mesh> mesh, const
 class Conformance : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(Conformance, AdversarialMeshesAndRays) {
-  const std::vector<std::pair<std::string, Mesh>> meshes = {{"empty mesh", Mesh{}},
-                                                            {"one triangle", one_triangle()},
-                                                            {"flat sheet", flat_sheet()},
-                                                            {"lattice cubes", lattice_cubes()},
-                                                            {"duplicates and degenerates", nasty_mix()}};
+  const std::vector<std::pair<std::string, Mesh>> meshes = {
+      {"empty mesh", Mesh{}},
+      {"one triangle", one_triangle()},
+      {"flat sheet", flat_sheet()},
+      {"lattice cubes", lattice_cubes()},
+      {"duplicates and degenerates", nasty_mix()},
+      {"pages around an edge", pages_around_edge()},
+      {"a stack one ulp apart", ulp_stack()},
+      {"a cluster on a huge ground", cluster_on_ground()}};
   for (const auto& [what, mesh] : meshes) {
     auto shared = share(mesh);
     check_mesh(GetParam(), shared, adversarial_rays(mesh, mesh.bounds(), 11), what);
