@@ -53,7 +53,8 @@ struct SahCosts {
   float leaf(size_t n) const { return intersection * tests(n); }
   /// Cost of splitting a node of area `parent_area` into children (area, count) pairs (areas relative to
   /// the parent's when parent_area is 1): lambda (traversal + intersection (A_l T_l + A_r T_r) / A).
-  float split(float parent_area, float left_area, size_t left_n, float right_area, size_t right_n) const {
+  [[gnu::always_inline]] float split(float parent_area, float left_area, size_t left_n, float right_area,
+                                     size_t right_n) const {
     const float lambda = (left_n == 0 || right_n == 0) ? 1.0f - empty_bonus : 1.0f;
     if (!(parent_area > 0.0f)) return lambda * (traversal + intersection * (tests(left_n) + tests(right_n)));
     return lambda * (traversal +
