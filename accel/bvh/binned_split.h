@@ -53,9 +53,10 @@ struct alignas(16) Box4 {
   }
   void extend(const Box4& b) { extend(b.lo, b.hi); }
   /// The same value as AABB::area() of the same box, 2 (dx dy + dy dz + dz dx) with the same rounding, and
-  /// 0 when empty (the extent is clamped at 0 instead of branching).
-  float area() const {
-    const __m128 d = _mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps());
+  /// 0 when empty (the extent is clamped at 0 instead of branching); with the extent multiplied by `frame`
+  /// (a power of two, sah.h's area_frame), which leaves it exact.
+  float area(float frame = 1.0f) const {
+    const __m128 d = _mm_mul_ps(_mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps()), _mm_set1_ps(frame));
     const __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));  // dx dy, dy dz, dz dx
     const __m128 s = _mm_add_ss(_mm_add_ss(p, _mm_shuffle_ps(p, p, 1)), _mm_shuffle_ps(p, p, 2));
     return 2.0f * _mm_cvtss_f32(s);
@@ -197,14 +198,15 @@ struct BinSet {
 /// (lo, -hi) form: the left ones in the low half of the result, the right ones in the high half. Each area
 /// is bit for bit AABB::area() (its products, in its order): the extent hi - lo is computed as
 /// -((-hi) + lo), which rounds to the same value (round to nearest is symmetric; a zero extent becomes -0,
-/// which the clamp at 0 turns into +0 as before).
-inline __m256 areas3_pair(const __m256* left, const __m256* right) {
+/// which the clamp at 0 turns into +0 as before). The extents are multiplied by `frame` (area_frame of the
+/// node, a power of two) before the products, so that areas at extreme scales neither overflow nor vanish.
+inline __m256 areas3_pair(const __m256* left, const __m256* right, __m256 frame) {
   const __m256 sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
   __m256 d[3];
   for (int a = 0; a < 3; ++a) {
     const __m256 lo = _mm256_permute2f128_ps(left[a], right[a], 0x20);
     const __m256 neg_hi = _mm256_permute2f128_ps(left[a], right[a], 0x31);
-    d[a] = _mm256_max_ps(_mm256_xor_ps(_mm256_add_ps(neg_hi, lo), sign), zero);
+    d[a] = _mm256_mul_ps(_mm256_max_ps(_mm256_xor_ps(_mm256_add_ps(neg_hi, lo), sign), zero), frame);
   }
   // The transpose of _MM_TRANSPOSE4_PS (rows d[0], d[1], d[2], 0) in both halves at once; the fourth row
   // is not needed.
@@ -224,8 +226,9 @@ inline __m256 areas3_pair(const __m256* left, const __m256* right) {
 /// is ranked by left_area * left_count + right_area * right_count (the cost without its constant terms, so
 /// no division per boundary); the first cheapest boundary of each axis is priced with SahCosts::split, and
 /// the first cheapest axis wins. Axes whose lane in `axis_ok` is clear (flat centroid extent) are skipped.
+/// Every area, the parent's included, is made in the node's area frame `frame` (sah.h).
 inline SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float parent_area,
-                                      const SahCosts& costs) {
+                                      const SahCosts& costs, float frame) {
   const int n = bins.nb;
   auto extend = [&](__m256* acc, int k) {
     for (int a = 0; a < 3; ++a) acc[a] = _mm256_min_ps(acc[a], bins.box[a * n + k].get());
@@ -236,12 +239,13 @@ inline SahSplit best_split_three_axes(const BinSet& bins, __m128 axis_ok, float 
   __m128i left_count[kMaxBins], right_count[kMaxBins];
   __m256 left[3] = {empty, empty, empty}, right[3] = {empty, empty, empty};
   __m128i lc = _mm_setzero_si128(), rc = _mm_setzero_si128();
+  const __m256 frame8 = _mm256_set1_ps(frame);
   for (int i = 1; i < n; ++i) {
     extend(left, i - 1);
     extend(right, n - i);
     lc = _mm_add_epi32(lc, bins.counts(i - 1));
     rc = _mm_add_epi32(rc, bins.counts(n - i));
-    const __m256 areas = areas3_pair(left, right);
+    const __m256 areas = areas3_pair(left, right, frame8);
     left_area[i] = _mm256_castps256_ps128(areas);
     right_area[n - i] = _mm256_extractf128_ps(areas, 1);
     left_count[i] = lc;
@@ -331,7 +335,8 @@ inline BinnedSplit find_binned_split(const BinRef* refs, uint32_t b, uint32_t e,
   auto evaluate = [&](const BinSet& bins) {
     const __m128 axis_ok =
         _mm_cmpgt_ps(_mm_setr_ps(map.scale[0], map.scale[1], map.scale[2], 0.0f), _mm_setzero_ps());
-    out.sah = best_split_three_axes(bins, axis_ok, node_box.area(), costs);
+    const float frame = area_frame(node_box.aabb().extent());
+    out.sah = best_split_three_axes(bins, axis_ok, node_box.area(frame), costs, frame);
     if (out.sah.axis < 0) return;
     const int base = out.sah.axis * bins.nb;
     for (int k = 0; k < bins.nb; ++k) {

@@ -42,13 +42,16 @@ template <TreeVisitor V>
 void walk_tree_stats(const V& v, BuildStats& stats) {
   using Node = typename V::Node;
   const Node root = v.root();
-  SahTreeCost sah(v.box(root).area());
+  // Areas in the root's area frame (sah.h), so the ratios hold at any scale.
+  const float frame = area_frame(v.box(root).extent());
+  auto area_of = [frame](const AABB& box) { return area_of_extent(box.extent() * frame); };
+  SahTreeCost sah(area_of(v.box(root)));
   std::vector<std::pair<Node, uint32_t>> todo{{root, 0u}};
   while (!todo.empty()) {
     const auto [node, depth] = todo.back();
     todo.pop_back();
     ++stats.nodes;
-    const float area = v.box(node).area();
+    const float area = area_of(v.box(node));
     if (v.is_leaf(node)) {
       const uint32_t n = v.count(node);
       stats.add_leaf(n, depth);
